@@ -1,0 +1,66 @@
+#pragma once
+// BO-ICP: Bayesian optimisation over ICP's initial transform (Biggie,
+// Beathard, Heckman), nested (rotation, then translation) or in 6 DOF,
+// followed by a fine ICP refinement.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/config.hpp"
+#include "boicp/types.hpp"
+
+namespace boicp {
+
+/// One ICP run started by the search.
+struct Evaluation {
+  int stage = 0;                              // 0 = rotation / joint, 1 = translation
+  Transform initial = Transform::Identity();  // T0 that BO proposed
+  Transform result = Transform::Identity();   // where ICP took it
+  double objective = 0.0;                     // truncated mean distance after ICP, metres
+};
+
+/// Result of registering one pair. Frame convention: `transform` is
+/// T_target_source, so p_target = transform * p_source (metres, radians).
+struct RegistrationResult {
+  Transform transform = Transform::Identity();
+  double objective = 0.0;    // best search objective (truncated mean NN distance, metres)
+  double fitness = 0.0;      // fraction of refined source points within inlier_distance
+  double inlier_rmse = 0.0;  // RMS distance of those points, metres
+  /// In [0,1]: fitness x (1 - probability_better). High when most of the
+  /// source lies on the target and the surrogate sees no unexplored region
+  /// likely to beat the answer.
+  double confidence = 0.0;
+  double gp_mean = 0.0;             // GP posterior mean at the optimum (last stage), metres
+  double gp_std = 0.0;              // GP posterior standard deviation there, metres
+  double probability_better = 0.0;  // max over stages of the GP's P(some other point is better)
+  int evaluations = 0;              // ICP runs made by the search
+  double runtime_s = 0.0;           // wall time of RegisterPair
+  size_t source_points = 0;         // after search downsampling
+  size_t target_points = 0;
+  std::vector<Evaluation> history;
+};
+
+struct RegistrationProgress {
+  std::string stage;  // "rotation", "translation", "6dof" or "refine"
+  int done = 0;       // evaluations finished in this stage
+  int total = 0;      // evaluations planned in this stage
+  double best_objective = 0.0;
+};
+
+struct RegistrationCallbacks {
+  std::function<void(const RegistrationProgress&)> progress;
+  std::function<bool()> stop_requested;  // polled between evaluations; true -> boicp::Cancelled
+};
+
+/// Registers `source` onto `target` (raw clouds in their sensor frames).
+/// `prior`, when given (for example odometry), centres the search box and is
+/// the first sample. Throws InputError for an invalid config or a cloud left
+/// empty by cropping/downsampling, and Cancelled when stop_requested fires.
+RegistrationResult RegisterPair(const Points& source, const Points& target,
+                                const BoIcpConfig& config,
+                                const std::optional<Transform>& prior = std::nullopt,
+                                const RegistrationCallbacks& callbacks = {});
+
+}  // namespace boicp

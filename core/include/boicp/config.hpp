@@ -1,0 +1,80 @@
+#pragma once
+// One configuration struct for a BO-ICP registration, with the paper's presets.
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "boicp/bayes_opt.hpp"
+
+namespace boicp {
+
+enum class SearchMode {
+  kNested,  // rotation (roll, pitch, yaw) first, then translation with that rotation fixed
+  kSixDof,  // all six degrees of freedom in one search
+};
+
+SearchMode ParseSearchMode(const std::string& name);  // "nested" | "6dof"; throws InputError
+std::string SearchModeName(SearchMode mode);
+
+struct BoIcpConfig {
+  std::string preset = "C";  // name of the preset these values started from
+
+  // --- Search (the paper's N_r, N and voxel) -------------------------------
+  int random_samples = 30;  // N_r: space-filling samples per search stage
+  int iterations = 60;      // N: expected-improvement steps per search stage
+  double voxel = 0.6;       // metres: both clouds are downsampled to this for the search
+  SearchMode mode = SearchMode::kNested;
+
+  // Half-widths of the search box. Rotations are offsets (roll about x, pitch
+  // about y, yaw about z; R = Rz Ry Rx) applied about the source centroid;
+  // translations are offsets from the translation that puts the source
+  // centroid on the target centroid (or from the prior, when one is given).
+  // Pitch is capped at pi/2: with roll and yaw spanning +-pi that covers every
+  // rotation exactly once, so no rotation appears twice in the box.
+  Eigen::Vector3d rotation_bounds{M_PI, M_PI / 2, M_PI};  // radians (roll, pitch, yaw)
+  Eigen::Vector3d translation_bounds{4.0, 2.0, 1.0};      // metres (x, y, z), the paper's
+
+  // --- ICP run by every evaluation ----------------------------------------
+  double max_correspondence_distance = 0.0;  // metres; 0 = 3 x voxel
+  // Clipping distance tau of the objective (truncated mean NN distance),
+  // metres; 0 = 1.5 x voxel. Tighter than the ICP gate so that a larger but
+  // looser overlap (a view slid along a wall) does not outscore the true one.
+  double objective_truncation = 0.0;
+  int icp_max_iterations = 60;      // per evaluation; fewer shrink the basin each start reaches
+  size_t evaluation_points = 3000;  // source points (random, seeded) each evaluation uses; 0 = all
+
+  // --- Final refinement of the best candidate ------------------------------
+  double refine_voxel = 0.0;  // metres, finest level of the refinement pyramid; 0 = voxel / 4
+  int refine_max_iterations = 60;
+  int refine_candidates = 3;  // distinct best search results refined; the best fit at the end wins
+  double inlier_distance =
+      0.0;  // metres, for fitness / inlier_rmse / confidence; 0 = 1.5 x refine voxel
+
+  // --- Preprocessing --------------------------------------------------------
+  double min_range = 0.0;  // metres from the sensor; points closer are dropped
+  double max_range = 0.0;  // metres; 0 = no limit
+
+  // --- Surrogate and acquisition ----------------------------------------------
+  BayesOptOptions bo;  // random_samples / iterations are copied into it per stage
+
+  uint64_t seed = 1;  // drives the initial design, subsampling and acquisition
+  int threads = 1;    // for nearest-neighbour searches inside one registration
+
+  // Derived values (the "0 = auto" rules above).
+  double EffectiveMaxCorrespondence() const;
+  double EffectiveTruncation() const;
+  double EffectiveRefineVoxel() const;
+  double EffectiveInlierDistance() const;
+};
+
+/// Preset "A" (10 random / 20 iterations / 0.7 m), "B" (20 / 35 / 0.7) or
+/// "C" (30 / 60 / 0.6), from the paper; case-insensitive. Throws InputError.
+BoIcpConfig PresetConfig(const std::string& name);
+
+/// Throws InputError naming the first invalid field (non-positive voxel,
+/// negative or non-finite bounds, all bounds zero, N_r < 1, ...).
+void ValidateConfig(const BoIcpConfig& config);
+
+}  // namespace boicp

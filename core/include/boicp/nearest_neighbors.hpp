@@ -1,0 +1,34 @@
+#pragma once
+// A kd-tree over a fixed target cloud, built once and queried many times:
+// BO-ICP evaluates hundreds of ICP runs against one target, so the tree must
+// outlive any single run (Open3D's RegistrationICP rebuilds it per call).
+
+#include <memory>
+
+#include "boicp/types.hpp"
+
+namespace boicp {
+
+class NearestNeighborIndex {
+ public:
+  /// Builds the tree over a copy of `points`. Precondition: points non-empty.
+  explicit NearestNeighborIndex(Points points);
+  ~NearestNeighborIndex();
+  NearestNeighborIndex(NearestNeighborIndex&&) noexcept;
+  NearestNeighborIndex& operator=(NearestNeighborIndex&&) noexcept;
+
+  /// Nearest target point to `query` within sqrt(max_squared_distance) metres.
+  /// Returns false when there is none; otherwise sets index and squared distance.
+  /// Thread-safe for concurrent queries; allocates nothing.
+  bool Nearest(const Point& query, double max_squared_distance, size_t& index,
+               double& squared_distance) const;
+
+  const Points& points() const;
+  size_t size() const { return points().size(); }
+
+ private:
+  struct Tree;
+  std::unique_ptr<Tree> tree_;
+};
+
+}  // namespace boicp

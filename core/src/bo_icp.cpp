@@ -1,0 +1,262 @@
+
+#include "boicp/bo_icp.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "boicp/alignment_score.hpp"
+#include "boicp/icp.hpp"
+#include "boicp/nearest_neighbors.hpp"
+#include "boicp/preprocess.hpp"
+#include "boicp/search_space.hpp"
+
+namespace boicp {
+namespace {
+
+// Distinct seeds for the independent random choices of one registration.
+constexpr uint64_t kSubsampleSalt = 0x9e3779b97f4a7c15ULL;
+constexpr uint64_t kStageSalt = 0xbf58476d1ce4e5b9ULL;
+
+Points Prepare(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
+  Points cropped = CropByRange(raw, config.min_range, config.max_range);
+  Points sampled = VoxelDownsample(cropped, voxel);
+  if (sampled.size() < 3) {
+    throw InputError(std::string(which) + " cloud has " + std::to_string(sampled.size()) +
+                     " points after cropping and downsampling (need at least 3)");
+  }
+  return sampled;
+}
+
+// Everything one registration evaluates against, built once per pair.
+struct PairContext {
+  Points search_source;      // voxel-downsampled source
+  Points evaluation_source;  // subsample of it used by every BO evaluation
+  NearestNeighborIndex search_target;
+  IcpOptions search_icp;
+};
+
+class Search {
+ public:
+  Search(const PairContext& pair, const BoIcpConfig& config, const RegistrationCallbacks& callbacks)
+      : pair_(pair), config_(config), callbacks_(callbacks) {}
+
+  // Runs one BO stage over `space`; the box centre (the anchor) is the first
+  // sample, followed by `extra_starts` (unit coordinates).
+  BayesOptResult RunStage(int stage, const SearchSpace& space, const std::string& name,
+                          const std::vector<Eigen::VectorXd>& extra_starts = {}) {
+    BayesOptOptions options = config_.bo;
+    options.initial_samples = config_.random_samples;
+    options.iterations = config_.iterations;
+    const int total = options.initial_samples + options.iterations;
+    int done = 0;
+    double best = 0.0;
+    const UnitObjective objective = [&](const Eigen::VectorXd& u) {
+      const double value = Evaluate(stage, space.ToTransform(u));
+      best = done == 0 ? value : std::min(best, value);
+      ++done;
+      if (callbacks_.progress) callbacks_.progress({name, done, total, best});
+      return value;
+    };
+    std::vector<Eigen::VectorXd> starts = {Eigen::VectorXd::Constant(space.dimension(), 0.5)};
+    starts.insert(starts.end(), extra_starts.begin(), extra_starts.end());
+    return MinimiseBayesOpt(objective, space.Periodic(), options,
+                            config_.seed ^ (kStageSalt * static_cast<uint64_t>(stage + 1)), starts,
+                            {}, callbacks_.stop_requested);
+  }
+
+  const Evaluation& Best() const {
+    return *std::min_element(
+        history_.begin(), history_.end(),
+        [](const Evaluation& a, const Evaluation& b) { return a.objective < b.objective; });
+  }
+  std::vector<Evaluation>& history() { return history_; }
+
+ private:
+  // The paper's objective: the error ICP reaches when started from T0.
+  double Evaluate(int stage, const Transform& initial) {
+    const IcpResult icp =
+        AlignPointToPoint(pair_.evaluation_source, pair_.search_target, initial, pair_.search_icp);
+    const AlignmentScore score =
+        ScoreAlignment(pair_.evaluation_source, pair_.search_target, icp.transform,
+                       config_.EffectiveTruncation(), config_.threads);
+    history_.push_back({stage, initial, icp.transform, score.truncated_mean});
+    return score.truncated_mean;
+  }
+
+  const PairContext& pair_;
+  const BoIcpConfig& config_;
+  const RegistrationCallbacks& callbacks_;
+  std::vector<Evaluation> history_;
+};
+
+// Unit coordinates of translation t in a translation-only search box, clamped
+// into the box.
+Eigen::VectorXd TranslationToUnit(const SearchSpace& space, const Eigen::Vector3d& t) {
+  const Eigen::Vector3d offset = t - space.anchor.topRightCorner<3, 1>();
+  Eigen::VectorXd u(space.dimension());
+  for (int k = 0; k < space.dimension(); ++k) {
+    const int p = space.parameters[k];
+    u[k] = std::clamp(0.5 + offset[p - kX] / (2.0 * space.half_widths[p]), 0.0, 1.0);
+  }
+  return u;
+}
+
+// Voxel sizes of the refinement pyramid: halving from the search voxel down to
+// the refinement voxel, so every level starts inside the next level's basin.
+std::vector<double> RefinementVoxels(double search_voxel, double refine_voxel) {
+  std::vector<double> voxels;
+  for (double v = search_voxel / 2; v > refine_voxel * 1.01; v /= 2) voxels.push_back(v);
+  voxels.push_back(refine_voxel);
+  return voxels;
+}
+
+// One level of the refinement pyramid, downsampled once per pair.
+struct PyramidLevel {
+  double voxel;
+  Points source;
+  NearestNeighborIndex target;
+};
+
+std::vector<PyramidLevel> BuildPyramid(const Points& raw_source, const Points& raw_target,
+                                       const BoIcpConfig& config) {
+  std::vector<PyramidLevel> levels;
+  for (double voxel : RefinementVoxels(config.voxel, config.EffectiveRefineVoxel())) {
+    levels.push_back({voxel, Prepare(raw_source, config, voxel, "source"),
+                      NearestNeighborIndex(Prepare(raw_target, config, voxel, "target"))});
+  }
+  return levels;
+}
+
+// Coarse-to-fine point-to-point ICP from a search result: all search points
+// first, then each pyramid level with a gate of 3 voxels.
+Transform Refine(const Transform& start, const PairContext& pair,
+                 const std::vector<PyramidLevel>& pyramid, const BoIcpConfig& config) {
+  IcpOptions options = pair.search_icp;
+  options.max_iterations = config.refine_max_iterations;
+  options.max_correspondence_distance = 1.5 * config.voxel;
+  Transform T = AlignPointToPoint(pair.search_source, pair.search_target, start, options).transform;
+  for (const PyramidLevel& level : pyramid) {
+    options.max_correspondence_distance = 3.0 * level.voxel;
+    options.convergence_translation = 1e-3 * level.voxel;
+    T = AlignPointToPoint(level.source, level.target, T, options).transform;
+  }
+  return T;
+}
+
+// The best search results that ended in different places (more than 5 degrees
+// or 3 voxels apart), best first, at most `count`.
+std::vector<Evaluation> DistinctBest(std::vector<Evaluation> history, int count, double voxel) {
+  std::sort(history.begin(), history.end(),
+            [](const Evaluation& a, const Evaluation& b) { return a.objective < b.objective; });
+  std::vector<Evaluation> picked;
+  for (const Evaluation& e : history) {
+    if (static_cast<int>(picked.size()) >= count) break;
+    const bool repeats = std::any_of(picked.begin(), picked.end(), [&](const Evaluation& p) {
+      const Transform delta = p.result.inverse() * e.result;
+      return RotationAngle(delta) < 5.0 * M_PI / 180.0 && TranslationNorm(delta) < 3.0 * voxel;
+    });
+    if (!repeats) picked.push_back(e);
+  }
+  return picked;
+}
+
+}  // namespace
+
+RegistrationResult RegisterPair(const Points& source, const Points& target,
+                                const BoIcpConfig& config, const std::optional<Transform>& prior,
+                                const RegistrationCallbacks& callbacks) {
+  const auto started = std::chrono::steady_clock::now();
+  ValidateConfig(config);
+
+  Points search_source = Prepare(source, config, config.voxel, "source");
+  Points search_target = Prepare(target, config, config.voxel, "target");
+  Points evaluation_source =
+      RandomSubsample(search_source, config.evaluation_points, config.seed ^ kSubsampleSalt);
+  IcpOptions search_icp;
+  search_icp.max_correspondence_distance = config.EffectiveMaxCorrespondence();
+  search_icp.max_iterations = config.icp_max_iterations;
+  search_icp.convergence_translation = 1e-3 * config.voxel;
+  search_icp.threads = config.threads;
+  const PairContext pair{std::move(search_source), std::move(evaluation_source),
+                         NearestNeighborIndex(std::move(search_target)), search_icp};
+
+  // Without a prior the box is centred on "same orientation, centroids on top
+  // of each other"; with one, on the prior itself.
+  const Transform anchor = prior.value_or([&] {
+    Transform centroids = Transform::Identity();
+    centroids.topRightCorner<3, 1>() =
+        Centroid(pair.search_target.points()) - Centroid(pair.search_source);
+    return centroids;
+  }());
+  const Point pivot =
+      anchor.topLeftCorner<3, 3>() * Centroid(pair.search_source) + anchor.topRightCorner<3, 1>();
+
+  Search search(pair, config, callbacks);
+  RegistrationResult result;
+  BayesOptResult last;
+  if (config.mode == SearchMode::kNested) {
+    const BayesOptResult rotation = search.RunStage(
+        0, MakeSearchSpace(anchor, pivot, config.rotation_bounds, Eigen::Vector3d::Zero()),
+        "rotation");
+    // The translation stage fixes the ICP-refined best rotation. Its box is
+    // centred where that rotation about the pivot puts the source, not on the
+    // ICP result: with partial overlap ICP may have slid far from the truth.
+    // The ICP result itself is the second sample.
+    const Transform rotated = search.Best().result;
+    Transform centred = rotated;
+    centred.topRightCorner<3, 1>() =
+        pivot - rotated.topLeftCorner<3, 3>() * Centroid(pair.search_source);
+    const SearchSpace translation =
+        MakeSearchSpace(centred, pivot, Eigen::Vector3d::Zero(), config.translation_bounds);
+    last = search.RunStage(1, translation, "translation",
+                           {TranslationToUnit(translation, rotated.topRightCorner<3, 1>())});
+    result.probability_better = std::max(rotation.probability_better, last.probability_better);
+  } else {
+    last = search.RunStage(
+        0, MakeSearchSpace(anchor, pivot, config.rotation_bounds, config.translation_bounds),
+        "6dof");
+    result.probability_better = last.probability_better;
+  }
+  const Evaluation best = search.Best();
+
+  // The search objective is measured on coarse voxels; a few distinct
+  // candidates are refined and the one that fits best at the finest level wins.
+  const std::vector<Evaluation> candidates =
+      DistinctBest(search.history(), config.refine_candidates, config.voxel);
+  const std::vector<PyramidLevel> pyramid = BuildPyramid(source, target, config);
+  const PyramidLevel& finest = pyramid.back();
+  AlignmentScore final_score;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    if (callbacks.progress) {
+      callbacks.progress(
+          {"refine", static_cast<int>(k), static_cast<int>(candidates.size()), best.objective});
+    }
+    const Transform refined = Refine(candidates[k].result, pair, pyramid, config);
+    const AlignmentScore score = ScoreAlignment(finest.source, finest.target, refined,
+                                                config.EffectiveInlierDistance(), config.threads);
+    if (k == 0 || score.truncated_mean < final_score.truncated_mean) {
+      final_score = score;
+      result.transform = refined;
+    }
+  }
+  if (callbacks.progress) {
+    const int n = static_cast<int>(candidates.size());
+    callbacks.progress({"refine", n, n, best.objective});
+  }
+
+  result.objective = best.objective;
+  result.fitness = final_score.fitness;
+  result.inlier_rmse = final_score.inlier_rmse;
+  result.confidence = final_score.fitness * (1.0 - result.probability_better);
+  result.gp_mean = last.gp_mean_at_best;
+  result.gp_std = last.gp_std_at_best;
+  result.evaluations = static_cast<int>(search.history().size());
+  result.source_points = pair.search_source.size();
+  result.target_points = pair.search_target.size();
+  result.history = std::move(search.history());
+  result.runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+}  // namespace boicp

@@ -1,0 +1,104 @@
+#include "boicp/icp.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/SVD>
+
+namespace boicp {
+namespace {
+
+constexpr size_t kNoMatch = std::numeric_limits<size_t>::max();
+
+// Matches every source point (moved by R, t) to its nearest target point within
+// the gate. Each point writes only its own slot, so the parallel loop gives the
+// same result as the serial one.
+void MatchNearest(const Points& source, const NearestNeighborIndex& target,
+                  const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double max_sq_distance,
+                  int threads, Points& moved, std::vector<size_t>& match,
+                  std::vector<double>& sq_distance) {
+  const auto n = static_cast<long>(source.size());
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+  for (long i = 0; i < n; ++i) {
+    moved[i] = R * source[i] + t;
+    size_t index = 0;
+    double d2 = 0.0;
+    if (target.Nearest(moved[i], max_sq_distance, index, d2)) {
+      match[i] = index;
+      sq_distance[i] = d2;
+    } else {
+      match[i] = kNoMatch;
+    }
+  }
+}
+
+}  // namespace
+
+Transform RigidFromCrossCovariance(const Point& source_mean, const Point& target_mean,
+                                   const Eigen::Matrix3d& cross_covariance) {
+  // H = sum (p - p_mean)(q - q_mean)^T = U S V^T; R = V diag(1, 1, det(V U^T)) U^T.
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross_covariance,
+                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d reflection_fix = Eigen::Matrix3d::Identity();
+  reflection_fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  const Eigen::Matrix3d R = svd.matrixV() * reflection_fix * svd.matrixU().transpose();
+  Transform T = Transform::Identity();
+  T.topLeftCorner<3, 3>() = R;
+  T.topRightCorner<3, 1>() = target_mean - R * source_mean;
+  return T;
+}
+
+IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& target,
+                            const Transform& initial, const IcpOptions& options) {
+  IcpResult result;
+  result.transform = initial;
+  Points moved(source.size());
+  std::vector<size_t> match(source.size(), kNoMatch);
+  std::vector<double> sq_distance(source.size(), 0.0);
+  const double max_sq = options.max_correspondence_distance * options.max_correspondence_distance;
+  const Points& target_points = target.points();
+
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    const Eigen::Matrix3d R = result.transform.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = result.transform.topRightCorner<3, 1>();
+    MatchNearest(source, target, R, t, max_sq, options.threads, moved, match, sq_distance);
+
+    // Serial reduction in index order keeps the sums bit-identical for any thread count.
+    size_t count = 0;
+    double sum_sq = 0.0;
+    Point source_mean = Point::Zero(), target_mean = Point::Zero();
+    for (size_t i = 0; i < source.size(); ++i) {
+      if (match[i] == kNoMatch) continue;
+      ++count;
+      sum_sq += sq_distance[i];
+      source_mean += moved[i];
+      target_mean += target_points[match[i]];
+    }
+    result.iterations = iteration + 1;
+    result.correspondences = count;
+    if (count < 3) {
+      result.rmse = 0.0;
+      result.converged = false;
+      return result;
+    }
+    result.rmse = std::sqrt(sum_sq / static_cast<double>(count));
+    source_mean /= static_cast<double>(count);
+    target_mean /= static_cast<double>(count);
+    Eigen::Matrix3d cross_covariance = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < source.size(); ++i) {
+      if (match[i] == kNoMatch) continue;
+      cross_covariance +=
+          (moved[i] - source_mean) * (target_points[match[i]] - target_mean).transpose();
+    }
+    const Transform step = RigidFromCrossCovariance(source_mean, target_mean, cross_covariance);
+    result.transform = step * result.transform;
+    if (TranslationNorm(step) < options.convergence_translation &&
+        RotationAngle(step) < options.convergence_rotation) {
+      result.converged = true;
+      break;
+    }
+  }
+  return result;
+}
+
+}  // namespace boicp

@@ -1,0 +1,117 @@
+// `boicp register` and `boicp demo-data` as a script sees them: exit codes,
+// one JSON object on stdout, one-line errors on stderr.
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("boicp_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  RunResult Run(const std::string& args) {
+    const std::string command = std::string(BOICP_CLI_PATH) + " " + args + " >" +
+                                (dir_ / "out").string() + " 2>" + (dir_ / "err").string();
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(dir_ / "out"), Slurp(dir_ / "err")};
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const RunResult r = Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
+                          (dir_ / "target.xyz").string() +
+                          " --config A --seed 3 --rotation-bounds 0.2,0.2,3.14159 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);  // throws if anything else is on stdout
+  for (const char* key : {"transform", "objective", "fitness", "inlier_rmse", "confidence",
+                          "evaluations", "runtime_s", "config"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  std::ifstream truth_file(dir_ / "truth.txt");
+  double truth[16];
+  for (double& v : truth) truth_file >> v;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(j["transform"][i][3].get<double>(), truth[4 * i + 3], 0.1) << "row " << i;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(j["transform"][i][k].get<double>(), truth[4 * i + k], 0.02);
+  }
+  EXPECT_EQ(j["config"]["preset"], "A");
+  EXPECT_EQ(j["evaluations"], 60);  // nested: (10 + 20) per stage
+}
+
+TEST_F(Cli, BadInputGivesOneLineErrorAndExitCode2) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const std::string pair =
+      "--source " + (dir_ / "source.xyz").string() + " --target " + (dir_ / "target.xyz").string();
+  std::ofstream(dir_ / "bad.bin") << "abc";
+  std::ofstream(dir_ / "cloud.foo") << "1 2 3\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--source /nonexistent.pcd --target " + (dir_ / "target.xyz").string(), "nonexistent"},
+      {"--source " + (dir_ / "bad.bin").string() + " --target " + (dir_ / "target.xyz").string(),
+       "bad.bin"},
+      {"--source " + (dir_ / "cloud.foo").string() + " --target " + (dir_ / "target.xyz").string(),
+       "cloud.foo"},
+      {pair + " --voxel -1", "voxel"},
+      {pair + " --translation-bounds 1,2", "--translation-bounds"},
+      {pair + " --config Z", "preset"},
+      {pair + " --max-range 0.01", "points after cropping"},
+      {pair + " --prior /nonexistent_prior.txt", "nonexistent_prior"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const RunResult r = Run("register " + args + " --json");
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_THAT(r.err, HasSubstr(expected)) << args;
+    EXPECT_TRUE(r.out.empty()) << args;
+    // Progress lines may precede it, but the error itself is exactly one line, the last.
+    const std::string last_line = r.err.substr(r.err.rfind('\n', r.err.size() - 2) + 1);
+    EXPECT_THAT(last_line, ::testing::StartsWith("boicp register: error: ")) << r.err;
+    const size_t last_line_start = r.err.size() - last_line.size();
+    EXPECT_GE(r.err.find("error"), last_line_start) << "no earlier line mentions an error\n"
+                                                    << r.err;
+  }
+}
+
+TEST_F(Cli, MissingRequiredFlagAndHelp) {
+  EXPECT_EQ(Run("register --source x.pcd").exit_code, 2);
+  const RunResult help = Run("register --help");
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* flag : {"--voxel", "--translation-bounds", "--rotation-bounds", "--format",
+                           "--intrinsics", "--intrinsics-file", "--depth-scale", "--prior",
+                           "--config", "--mode", "--seed", "--json"}) {
+    EXPECT_THAT(help.out, HasSubstr(flag));
+  }
+}
+
+}  // namespace

@@ -1,0 +1,95 @@
+// BO-ICP end to end on a generated street: far from identity, both modes.
+
+#include <gtest/gtest.h>
+
+#include "boicp/bo_icp.hpp"
+#include "boicp/evaluation.hpp"
+#include "boicp/synthetic_scene.hpp"
+
+namespace boicp {
+namespace {
+
+struct StreetPair {
+  Points source, target;
+  Transform truth;  // T_target_source
+};
+
+StreetPair MakeStreetPair(double yaw) {
+  const Points world = MakeSyntheticStreet(11, 15.0);
+  const Transform T_world_target = PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8});
+  const Transform T_world_source = PoseFromYawTranslation(yaw, {1.2, 0.4, 1.8});
+  return {SimulateScan(world, T_world_source, 30.0, 0.01, 1),
+          SimulateScan(world, T_world_target, 30.0, 0.01, 2),
+          T_world_target.inverse() * T_world_source};
+}
+
+BoIcpConfig SmallConfig(SearchMode mode) {
+  BoIcpConfig config = PresetConfig("A");
+  config.mode = mode;
+  config.rotation_bounds = Eigen::Vector3d(0.2, 0.2, M_PI);  // a car: any yaw, small roll and pitch
+  config.evaluation_points = 1000;
+  config.seed = 5;
+  return config;
+}
+
+class BoIcpModes : public ::testing::TestWithParam<SearchMode> {};
+
+TEST_P(BoIcpModes, RecoversLargeYawOnSyntheticStreet) {
+  const StreetPair pair = MakeStreetPair(2.3);  // 132 degrees: plain ICP from identity fails
+  const RegistrationResult result = RegisterPair(pair.source, pair.target, SmallConfig(GetParam()));
+  EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
+  EXPECT_LT(TranslationErrorM(result.transform, pair.truth), 0.1);
+  EXPECT_GT(result.fitness, 0.5);
+  EXPECT_GT(result.confidence, 0.0);
+  EXPECT_LE(result.confidence, 1.0);
+  EXPECT_EQ(result.evaluations, static_cast<int>(result.history.size()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, BoIcpModes,
+                         ::testing::Values(SearchMode::kNested, SearchMode::kSixDof),
+                         [](const auto& info) {
+                           return SearchModeName(info.param) == "6dof" ? std::string("SixDof")
+                                                                       : std::string("Nested");
+                         });
+
+TEST(BoIcp, SameSeedSameAnswerAndThreadCountDoesNotMatter) {
+  const StreetPair pair = MakeStreetPair(0.9);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.iterations = 5;
+  const RegistrationResult a = RegisterPair(pair.source, pair.target, config);
+  config.threads = 2;
+  const RegistrationResult b = RegisterPair(pair.source, pair.target, config);
+  EXPECT_TRUE(a.transform == b.transform);
+  EXPECT_EQ(a.objective, b.objective);
+}
+
+TEST(BoIcp, PriorIsTheFirstSample) {
+  const StreetPair pair = MakeStreetPair(1.5);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.random_samples = 2;
+  config.iterations = 0;
+  const RegistrationResult result = RegisterPair(pair.source, pair.target, config, pair.truth);
+  ASSERT_FALSE(result.history.empty());
+  EXPECT_TRUE(result.history.front().initial.isApprox(pair.truth, 1e-12));
+  EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
+}
+
+TEST(BoIcp, StopRequestCancels) {
+  const StreetPair pair = MakeStreetPair(0.5);
+  RegistrationCallbacks callbacks;
+  int polls = 0;
+  callbacks.stop_requested = [&] { return ++polls > 3; };
+  EXPECT_THROW(RegisterPair(pair.source, pair.target, SmallConfig(SearchMode::kNested),
+                            std::nullopt, callbacks),
+               Cancelled);
+}
+
+TEST(BoIcp, EmptyAfterCroppingIsAnInputError) {
+  const StreetPair pair = MakeStreetPair(0.5);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.max_range = 0.5;
+  EXPECT_THROW(RegisterPair(pair.source, pair.target, config), InputError);
+}
+
+}  // namespace
+}  // namespace boicp

@@ -1,0 +1,110 @@
+// Point-to-point ICP, the alignment score and the search box on synthetic data.
+
+#include <gtest/gtest.h>
+
+#include "boicp/alignment_score.hpp"
+#include "boicp/icp.hpp"
+#include "boicp/preprocess.hpp"
+#include "boicp/search_space.hpp"
+#include "boicp/synthetic_scene.hpp"
+
+namespace boicp {
+namespace {
+
+Transform SmallMotion() {
+  Transform T = Transform::Identity();
+  T.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(0.08, Eigen::Vector3d(0.2, 0.3, 1.0).normalized()).toRotationMatrix();
+  T.topRightCorner<3, 1>() = Eigen::Vector3d(0.3, -0.2, 0.05);
+  return T;
+}
+
+Points StreetSample() { return VoxelDownsample(MakeSyntheticStreet(3, 20.0), 0.3); }
+
+TEST(Icp, RecoversKnownSmallTransformExactlyOnNoiselessData) {
+  const Points target = StreetSample();
+  const Transform truth = SmallMotion();
+  // source = truth^-1 * target, so T_target_source = truth exactly.
+  const Points source = TransformPoints(truth.inverse(), target);
+  const NearestNeighborIndex index(target);
+  IcpOptions options;
+  options.max_correspondence_distance = 2.0;
+  options.max_iterations = 100;
+  options.convergence_translation = 1e-9;
+  options.convergence_rotation = 1e-10;
+  const IcpResult result = AlignPointToPoint(source, index, Transform::Identity(), options);
+  EXPECT_LT(RotationAngle(result.transform.inverse() * truth), 1e-6);
+  EXPECT_LT(TranslationNorm(result.transform.inverse() * truth), 1e-6);
+  EXPECT_LT(result.rmse, 1e-6);
+  EXPECT_EQ(result.correspondences, source.size());
+}
+
+TEST(Icp, SerialAndParallelGiveIdenticalResults) {
+  const Points target = StreetSample();
+  const Points source = TransformPoints(SmallMotion().inverse(), target);
+  const NearestNeighborIndex index(target);
+  IcpOptions serial;
+  serial.max_correspondence_distance = 1.0;
+  IcpOptions parallel = serial;
+  parallel.threads = 2;
+  const IcpResult a = AlignPointToPoint(source, index, Transform::Identity(), serial);
+  const IcpResult b = AlignPointToPoint(source, index, Transform::Identity(), parallel);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.correspondences, b.correspondences);
+  EXPECT_TRUE(a.transform == b.transform) << a.transform << "\nvs\n" << b.transform;
+  const AlignmentScore sa = ScoreAlignment(source, index, a.transform, 0.5, 1);
+  const AlignmentScore sb = ScoreAlignment(source, index, a.transform, 0.5, 2);
+  EXPECT_EQ(sa.truncated_mean, sb.truncated_mean);
+  EXPECT_EQ(sa.fitness, sb.fitness);
+}
+
+TEST(Icp, StopsWithoutCorrespondences) {
+  const Points target = {Point(0, 0, 0), Point(1, 0, 0), Point(0, 1, 0)};
+  const Points source = {Point(100, 0, 0), Point(101, 0, 0), Point(100, 1, 0)};
+  const NearestNeighborIndex index(target);
+  const IcpResult result = AlignPointToPoint(source, index, Transform::Identity(), IcpOptions{});
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.correspondences, 0u);
+  EXPECT_TRUE(result.transform.isIdentity());
+}
+
+TEST(AlignmentScore, ClipsDistancesAtTau) {
+  const Points target = {Point(0, 0, 0)};
+  const NearestNeighborIndex index(target);
+  // Distances 0.1 and 5.0; tau 1.0 -> clipped mean (0.1 + 1.0) / 2.
+  const Points source = {Point(0.1, 0, 0), Point(5, 0, 0)};
+  const AlignmentScore score = ScoreAlignment(source, index, Transform::Identity(), 1.0);
+  EXPECT_NEAR(score.truncated_mean, 0.55, 1e-12);
+  EXPECT_NEAR(score.fitness, 0.5, 1e-12);
+  EXPECT_NEAR(score.inlier_rmse, 0.1, 1e-12);
+}
+
+TEST(SearchSpace, CentreIsTheAnchorAndRollYawWrap) {
+  Transform anchor = SmallMotion();
+  const SearchSpace space =
+      MakeSearchSpace(anchor, Point(1, 2, 3), {M_PI, M_PI / 2, M_PI}, Eigen::Vector3d::Zero());
+  ASSERT_EQ(space.dimension(), 3);
+  EXPECT_TRUE(space.ToTransform(Eigen::Vector3d::Constant(0.5)).isApprox(anchor, 1e-12));
+  EXPECT_EQ(space.Periodic(), (std::vector<bool>{true, false, true}));
+  // u = 0 and u = 1 on roll and yaw are the same rotation (-pi == +pi).
+  const Transform low = space.ToTransform(Eigen::Vector3d(0.0, 0.3, 0.0));
+  const Transform high = space.ToTransform(Eigen::Vector3d(1.0, 0.3, 1.0));
+  EXPECT_TRUE(low.isApprox(high, 1e-9));
+  // The pivot, mapped by the anchor's offset rotation, stays where it is.
+  const Transform some = space.ToTransform(Eigen::Vector3d(0.2, 0.7, 0.9));
+  const Transform offset = some * anchor.inverse();
+  const Point moved_pivot = TransformPoints(offset, {Point(1, 2, 3)}).front();
+  EXPECT_TRUE(moved_pivot.isApprox(Point(1, 2, 3), 1e-9));
+}
+
+TEST(SearchSpace, ZeroHalfWidthsAreNotSearched) {
+  const SearchSpace space = MakeSearchSpace(Transform::Identity(), Point::Zero(),
+                                            Eigen::Vector3d::Zero(), Eigen::Vector3d(4, 2, 0));
+  EXPECT_EQ(space.dimension(), 2);
+  const Transform corner = space.ToTransform(Eigen::Vector2d(1.0, 0.0));
+  const Eigen::Vector3d translation = corner.topRightCorner<3, 1>();
+  EXPECT_TRUE(translation.isApprox(Eigen::Vector3d(4, -2, 0)));
+}
+
+}  // namespace
+}  // namespace boicp
