@@ -1,15 +1,11 @@
 // boicp: BO-ICP point-cloud registration and map building from the command line.
 
-#include <cstdlib>
 #include <iostream>
 #include <map>
 
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
-  // Our parallel loops are short; spinning OpenMP workers would steal the other
-  // cores from concurrent jobs on a shared machine. A user's setting wins.
-  setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0);
   CLI::App app{"boicp: globally initialised ICP registration (BO-ICP) and map building"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "boicp 0.1.0");
