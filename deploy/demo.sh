@@ -1,18 +1,56 @@
 #!/usr/bin/env bash
-# The main job on a fresh machine: install dependencies, build, generate a
-# demo pair of street scans 135 degrees apart and register it with BO-ICP.
-# Usage: bash deploy/demo.sh [OUTDIR]   (default: build/demo)
+# The main job on a fresh machine: install dependencies, build everything,
+# start boicpd on a free loopback port with its data directory under build/,
+# submit a demo batch (a generated drive, or the scans of --data DIR), show
+# its progress, write the map and trajectory files, and stop the daemon.
+# Usage: bash deploy/demo.sh [--data DIR] [--out OUTDIR] [--preset A|B|C]
+#   --data DIR   a folder of scans (.bin/.pcd/.ply/.xyz, or KITTI's velodyne/)
+#   --out OUTDIR default build/demo: map.bt map.ot map.ply trajectory.tum trajectory.kitti
+#   --preset P   BO-ICP preset, default C
+# BOICP_BUILD_DIR (default build) names the build folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out="${1:-build/demo}"
+
+build="${BOICP_BUILD_DIR:-build}"
+data="" out="$build/demo" preset="C"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --data) data="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --preset) preset="$2"; shift 2 ;;
+    *) echo "usage: bash deploy/demo.sh [--data DIR] [--out OUTDIR] [--preset A|B|C]" >&2; exit 2 ;;
+  esac
+done
 
 bash deploy/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j"$(nproc)" --target boicp
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
+cmake --build "$build" -j"$(nproc)"
 
-build/bin/boicp demo-data --out "$out"
-# A ground vehicle: roll and pitch within ~11 degrees, any yaw.
-build/bin/boicp register --source "$out/source.xyz" --target "$out/target.xyz" \
-  --config C --rotation-bounds 0.2,0.2,3.14159 --json | tee "$out/result.json"
-echo "truth (T_target_source) from $out/truth.txt:" >&2
-cat "$out/truth.txt" >&2
+data_dir="$build/boicpd-data"
+mkdir -p "$out"
+log="$out/boicpd.log"
+"$build/bin/boicpd" --listen 127.0.0.1:0 --data-dir "$data_dir" --workers "$(nproc)" >"$log" 2>&1 &
+pid=$!
+# Whatever happens below, the daemon is drained and stopped.
+trap 'kill -TERM "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true' EXIT
+
+addr=""
+for _ in $(seq 1 600); do
+  addr="$(grep -o 'listening on [^ ]*' "$log" | head -n 1 | cut -d' ' -f3 || true)"
+  [ -n "$addr" ] && break
+  if ! kill -0 "$pid" 2>/dev/null; then
+    echo "boicpd exited:" >&2; cat "$log" >&2; exit 1
+  fi
+  sleep 0.1
+done
+if [ -z "$addr" ]; then echo "boicpd did not start:" >&2; cat "$log" >&2; exit 1; fi
+echo "boicpd listening on $addr (log $log, data $data_dir)"
+
+args=(--server "$addr" --out "$out" --preset "$preset")
+if [ -n "$data" ]; then args+=(--data "$data"); fi
+"$build/bin/boicp-demo-client" "${args[@]}"
+
+kill -TERM "$pid"
+wait "$pid"
+trap - EXIT
+echo "done: $out/map.bt $out/map.ot $out/map.ply $out/trajectory.tum $out/trajectory.kitti"

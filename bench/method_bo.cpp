@@ -1,0 +1,36 @@
+// bo-A, bo-B, bo-C (nested) and bo-C-6dof: core's RegisterPair as it is.
+
+#include <optional>
+
+#include "boicp/bo_icp.hpp"
+#include "evaluation_clock.hpp"
+#include "methods.hpp"
+#include "shared_stages.hpp"
+
+namespace boicp::bench {
+
+MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& input) {
+  EvaluationClock clock;
+  const RegistrationResult result =
+      RegisterPair(input.source, input.target, config, std::nullopt, clock.Callbacks());
+  const EvaluationClock::Split split = clock.Estimate(result.runtime_s);
+  MethodOutput output;
+  output.transform = result.transform;
+  output.confidence = result.confidence;
+  output.evaluations = result.evaluations;
+  output.source_points = result.source_points;
+  output.target_points = result.target_points;
+  output.voxel = config.voxel;
+  output.iterations = config.iterations;
+  output.icp_s = split.icp_s;
+  output.model_s = split.model_s;
+  return output;
+}
+
+MethodOutput RunBoIcp(const std::string& preset, bool six_dof, const MethodInput& input) {
+  BoIcpConfig config = DatasetBoConfig(preset, input);
+  if (six_dof) config.mode = SearchMode::kSixDof;
+  return RunBoIcpWithConfig(config, input);
+}
+
+}  // namespace boicp::bench

@@ -1,0 +1,56 @@
+#pragma once
+// The registration methods the bench compares, behind one signature. Each
+// method gets the raw (perturbed) clouds and does all of its own
+// preprocessing, so its wall time covers everything it needs.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/config.hpp"
+#include "boicp/types.hpp"
+#include "dataset_table.hpp"
+
+namespace boicp::bench {
+
+struct MethodInput {
+  const Points& source;
+  const Points& target;
+  const DatasetSettings& dataset;
+  uint64_t seed = 1;
+  int threads = 1;     // the run's thread budget: every method gets the same
+  bool quick = false;  // smoke-test budgets (smaller RANSAC and pyramid budgets)
+};
+
+struct MethodOutput {
+  Transform transform = Transform::Identity();  // T_target_source
+  std::optional<double> confidence;             // only methods that report one
+  int evaluations = 0;                          // objective evaluations (ICP runs or grid scores)
+  size_t source_points = 0;                     // after the method's search downsampling
+  size_t target_points = 0;
+  double voxel = 0.0;             // the method's search voxel, metres
+  std::optional<int> iterations;  // BO: expected-improvement steps per stage
+  std::optional<double> icp_s;    // BO only: estimated time inside ICP evaluations
+  std::optional<double> model_s;  // BO only: the rest outside refinement (GP fit + acquisition)
+};
+
+/// Every method name, in the order tables and plots list them.
+const std::vector<std::string>& MethodNames();
+
+/// Runs `name` (one of MethodNames()) on one pair. Throws what the method throws.
+MethodOutput RunMethod(const std::string& name, const MethodInput& input);
+
+/// One line per method describing its budget, for summary.md.
+std::vector<std::string> DescribeMethods(const std::vector<std::string>& names, bool quick);
+
+// The methods themselves, one file each.
+MethodOutput RunBoIcp(const std::string& preset, bool six_dof, const MethodInput& input);
+MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& input);
+MethodOutput RunNaiveBoIcp(const MethodInput& input);
+MethodOutput RunIcpFromIdentity(const MethodInput& input);
+MethodOutput RunPyramid(const MethodInput& input);
+MethodOutput RunRansacFpfh(const MethodInput& input);
+MethodOutput RunFastGlobal(const MethodInput& input);
+
+}  // namespace boicp::bench

@@ -1,0 +1,51 @@
+#include "result_row.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace boicp::bench {
+namespace {
+
+std::string Number(double value, const char* format = "%.6g") {
+  if (!std::isfinite(value)) return "";
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+std::string Optional(const std::optional<double>& value) {
+  return value ? Number(*value) : std::string();
+}
+
+std::string Text(const std::string& value) {
+  if (value.find_first_of(",\"\n") == std::string::npos) return value;
+  std::string quoted = "\"";
+  for (char c : value) {
+    if (c == '"') quoted += '"';
+    quoted += c == '\n' ? ' ' : c;
+  }
+  return quoted + "\"";
+}
+
+}  // namespace
+
+std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
+  std::ostringstream out;
+  out << "experiment,dataset,source,target,method,threads,seed,perturb,voxel,iterations,"
+         "source_points,target_points,evaluations,wall_s,rot_err_deg,trans_err_m,mean_p2p_m,"
+         "overlap,success,confidence,icp_s,model_s,error\n";
+  for (const ResultRow& r : rows) {
+    out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ',' << Text(r.target)
+        << ',' << r.method << ',' << r.threads << ',' << r.seed << ',' << r.perturb << ','
+        << Number(r.voxel) << ',' << (r.iterations ? std::to_string(*r.iterations) : "") << ','
+        << r.source_points << ',' << r.target_points << ',' << r.evaluations << ','
+        << Number(r.wall_s, "%.4f") << ',' << Number(r.rot_err_deg) << ',' << Number(r.trans_err_m)
+        << ',' << Number(r.mean_p2p_m) << ',' << Number(r.overlap, "%.4f") << ','
+        << (r.success ? 1 : 0) << ',' << Optional(r.confidence) << ',' << Optional(r.icp_s) << ','
+        << Optional(r.model_s) << ',' << Text(r.error) << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace boicp::bench

@@ -1,0 +1,73 @@
+#include "auth.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <grpcpp/security/server_credentials.h>
+
+namespace boicp::server {
+namespace {
+
+std::string ReadFile(const std::string& path, const char* what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(std::string(what) + " " + path + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string Trim(const std::string& text) {
+  const char* space = " \t\r\n";
+  const size_t begin = text.find_first_not_of(space);
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(space) - begin + 1);
+}
+
+// Compares in time independent of where the strings differ.
+bool SameSecret(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (size_t i = 0; i < a.size(); ++i) {
+    diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
+  }
+  return diff == 0;
+}
+
+}  // namespace
+
+BearerAuth BearerAuth::FromFile(const std::string& path) {
+  BearerAuth auth;
+  auth.token_ = Trim(ReadFile(path, "auth token file"));
+  if (auth.token_->empty()) throw std::runtime_error("auth token file " + path + " is empty");
+  return auth;
+}
+
+grpc::Status BearerAuth::Check(const grpc::ServerContextBase& context) const {
+  if (!token_) return grpc::Status::OK;
+  const auto& metadata = context.client_metadata();
+  const auto found = metadata.find("authorization");
+  if (found == metadata.end()) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                        "missing 'authorization: Bearer <token>' metadata");
+  }
+  const std::string value(found->second.data(), found->second.size());
+  const std::string prefix = "Bearer ";
+  if (value.compare(0, prefix.size(), prefix) != 0 ||
+      !SameSecret(value.substr(prefix.size()), *token_)) {
+    return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "invalid bearer token");
+  }
+  return grpc::Status::OK;
+}
+
+std::shared_ptr<grpc::ServerCredentials> MakeServerCredentials(const std::string& cert_path,
+                                                               const std::string& key_path) {
+  if (cert_path.empty() && key_path.empty()) return grpc::InsecureServerCredentials();
+  if (cert_path.empty() || key_path.empty()) {
+    throw std::runtime_error("TLS needs both --tls-cert and --tls-key");
+  }
+  grpc::SslServerCredentialsOptions options;
+  options.pem_key_cert_pairs.push_back(
+      {ReadFile(key_path, "TLS key"), ReadFile(cert_path, "TLS certificate")});
+  return grpc::SslServerCredentials(options);
+}
+
+}  // namespace boicp::server

@@ -1,0 +1,78 @@
+#pragma once
+// A small synchronous client of boicp.v1.MapBuilder: upload (skipping bytes
+// the daemon already holds), submit, watch, fetch results and export. Used
+// by the demo client and the daemon's tests.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <grpcpp/grpcpp.h>
+
+#include "boicp/v1/map_builder.grpc.pb.h"
+
+namespace boicp::client {
+
+namespace v1 = ::boicp::v1;
+
+/// A call that ended with a status other than OK.
+class RpcError : public std::runtime_error {
+ public:
+  RpcError(const std::string& rpc, const grpc::Status& status);
+  grpc::StatusCode code() const { return code_; }
+
+ private:
+  grpc::StatusCode code_;
+};
+
+struct ConnectOptions {
+  std::string address;      // HOST:PORT
+  std::string token;        // bearer token; empty = none
+  std::string tls_ca_file;  // PEM roots; empty = plaintext
+  int max_message_bytes = 4 << 20;
+};
+
+/// Throws std::runtime_error when the CA file cannot be read.
+std::shared_ptr<grpc::Channel> Connect(const ConnectOptions& options);
+
+class MapBuilderClient {
+ public:
+  explicit MapBuilderClient(std::shared_ptr<grpc::Channel> channel, std::string token = "");
+
+  /// Adds the bearer token (if any) to a context for a raw stub call.
+  void Authorize(grpc::ClientContext& context) const;
+  v1::MapBuilder::Stub& stub() { return *stub_; }
+
+  /// Uploads a scan; when the daemon already holds these bytes only the
+  /// metadata is sent. metadata.size_bytes and sha256 are filled in here.
+  v1::UploadScanResponse Upload(const std::string& bytes, v1::ScanMetadata metadata,
+                                size_t chunk_bytes = 1 << 20);
+  /// Reads the file and uploads it. Throws std::runtime_error when unreadable.
+  v1::UploadScanResponse UploadFile(const std::string& path, const v1::ScanMetadata& metadata);
+
+  v1::Job Submit(const v1::SubmitBatchRequest& request);
+  v1::Job GetJob(const std::string& job_id);
+  v1::Job Cancel(const std::string& job_id);
+  v1::JobResults Results(const std::string& job_id);
+
+  /// Follows WatchJob to its end and returns the job of the last event.
+  /// Throws RpcError when the stream ends with an error status.
+  v1::Job Watch(const std::string& job_id,
+                const std::function<void(const v1::JobEvent&)>& on_event = {});
+
+  /// Writes one export to `path`; returns the number of bytes. Throws
+  /// RpcError, or std::runtime_error when the size does not match.
+  uint64_t ExportToFile(const std::string& job_id, v1::ExportFormat format,
+                        const std::string& path);
+
+ private:
+  std::unique_ptr<v1::MapBuilder::Stub> stub_;
+  std::string token_;
+};
+
+/// Lowercase hex SHA-256 of `bytes`, the scan id the daemon will assign.
+std::string ScanId(const std::string& bytes);
+
+}  // namespace boicp::client

@@ -1,0 +1,85 @@
+#include "daemon.hpp"
+
+#include <chrono>
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/server_builder.h>
+#include <spdlog/spdlog.h>
+
+namespace boicp::server {
+namespace {
+
+bool IsLoopback(const std::string& host) {
+  return host == "127.0.0.1" || host == "localhost" || host == "[::1]" || host == "::1";
+}
+
+}  // namespace
+
+Daemon::Daemon(const DaemonOptions& options) : options_(options) {
+  if (!options_.auth_token_file.empty()) auth_ = BearerAuth::FromFile(options_.auth_token_file);
+  auto credentials = MakeServerCredentials(options_.tls_cert, options_.tls_key);
+
+  data_dir_ = std::make_unique<DataDir>(options_.data_dir);
+  store_ = std::make_unique<JobStore>(data_dir_->DatabasePath());
+  watches_ = std::make_unique<WatchHub>();
+  ManagerOptions manager_options;
+  manager_options.workers = options_.workers;
+  manager_options.concurrent_jobs = options_.concurrent_jobs;
+  manager_options.registration_threads = options_.registration_threads;
+  manager_options.max_queued_jobs = options_.max_queued_jobs;
+  manager_options.max_batch_scans = options_.max_batch_scans;
+  manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
+  service_ = std::make_unique<MapBuilderService>(
+      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, options_.max_scan_bytes});
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort(options_.listen, credentials, &port);
+  builder.RegisterService(service_.get());
+  builder.SetMaxReceiveMessageSize(options_.max_message_bytes);
+  server_ = builder.BuildAndStart();
+  if (!server_ || port == 0) {
+    throw std::runtime_error("cannot listen on " + options_.listen +
+                             " (address in use or not valid)");
+  }
+  const std::string host = options_.listen.substr(0, options_.listen.rfind(':'));
+  address_ = host + ":" + std::to_string(port);
+  manager_->Start();
+
+  if (!IsLoopback(host) && !auth_.enabled()) {
+    spdlog::warn("serving {} without --auth-token-file: anyone who reaches it can submit jobs",
+                 address_);
+  }
+  spdlog::info("boicpd {} workers x {} registration threads, {} concurrent jobs, data in {}",
+               options_.workers, options_.registration_threads, options_.concurrent_jobs,
+               data_dir_->root());
+  spdlog::info("auth {}, TLS {}", auth_.enabled() ? "on" : "off",
+               options_.tls_cert.empty() ? "off" : "on");
+  spdlog::info("listening on {}", address_);
+}
+
+Daemon::~Daemon() { Shutdown(); }
+
+void Daemon::Shutdown() {
+  if (stopped_) return;
+  stopped_ = true;
+  spdlog::info("draining: no new jobs; running jobs stop at their next checkpoint");
+  if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(false);
+  manager_->Drain();
+  watches_->CloseAll(grpc::Status(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down"));
+  const auto grace = std::chrono::duration_cast<std::chrono::milliseconds>(
+      std::chrono::duration<double>(options_.shutdown_grace_s));
+  server_->Shutdown(std::chrono::system_clock::now() + grace);
+  server_->Wait();
+  try {
+    store_->Checkpoint();
+  } catch (const std::exception& e) {
+    spdlog::warn("database checkpoint failed: {}", e.what());
+  }
+  spdlog::info("stopped");
+}
+
+}  // namespace boicp::server

@@ -1,0 +1,64 @@
+#include "daemon_options.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace boicp::server {
+
+void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
+  o.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  app.add_option("--listen", o.listen, "HOST:PORT to serve on (port 0 picks a free port)")
+      ->capture_default_str();
+  app.add_option("--data-dir", o.data_dir, "Directory for the job database, scans and maps")
+      ->required();
+  app.add_option("--workers", o.workers, "Pair registrations running at once (pool threads)")
+      ->capture_default_str();
+  app.add_option("--jobs", o.concurrent_jobs, "Jobs running at once; they share the workers")
+      ->capture_default_str();
+  app.add_option("--registration-threads", o.registration_threads,
+                 "Threads inside one registration (workers x this = registration cores)")
+      ->capture_default_str();
+  app.add_option("--max-queued-jobs", o.max_queued_jobs,
+                 "Jobs allowed to wait; more is RESOURCE_EXHAUSTED")
+      ->capture_default_str();
+  app.add_option("--max-batch-scans", o.max_batch_scans, "Scans allowed in one batch")
+      ->capture_default_str();
+  app.add_option("--max-message-bytes", o.max_message_bytes,
+                 "Largest gRPC message accepted (upload chunks must fit)")
+      ->capture_default_str();
+  app.add_option("--max-scan-bytes", o.max_scan_bytes, "Largest scan accepted by UploadScan")
+      ->capture_default_str();
+  app.add_option("--auth-token-file", o.auth_token_file,
+                 "Require 'authorization: Bearer <token>' with the token in this file");
+  app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (TLS on with --tls-key)");
+  app.add_option("--tls-key", o.tls_key, "PEM private key");
+  app.add_option("--shutdown-grace", o.shutdown_grace_s,
+                 "Seconds SIGTERM waits for open calls before cancelling them")
+      ->capture_default_str();
+  app.add_option("--log-level", o.log_level, "trace, debug, info, warn or error")
+      ->capture_default_str();
+}
+
+void ValidateDaemonOptions(const DaemonOptions& o) {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw std::invalid_argument(message);
+  };
+  require(o.listen.rfind(':') != std::string::npos, "--listen must be HOST:PORT");
+  require(o.workers >= 1 && o.workers <= 1024, "--workers must be in 1..1024");
+  require(o.concurrent_jobs >= 1 && o.concurrent_jobs <= 1024, "--jobs must be in 1..1024");
+  require(o.registration_threads >= 1 && o.registration_threads <= 1024,
+          "--registration-threads must be in 1..1024");
+  require(o.max_queued_jobs >= 1, "--max-queued-jobs must be at least 1");
+  require(o.max_batch_scans >= 2, "--max-batch-scans must be at least 2");
+  require(o.max_message_bytes >= 1024, "--max-message-bytes must be at least 1024");
+  require(o.max_scan_bytes >= 16, "--max-scan-bytes must be at least 16");
+  require(o.shutdown_grace_s >= 0.0, "--shutdown-grace must be >= 0");
+  require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");
+  const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "critical"};
+  require(std::find(levels.begin(), levels.end(), o.log_level) != levels.end(),
+          "--log-level must be trace, debug, info, warn, error or critical");
+}
+
+}  // namespace boicp::server

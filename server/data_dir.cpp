@@ -1,0 +1,78 @@
+#include "data_dir.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+namespace boicp::server {
+namespace fs = std::filesystem;
+namespace {
+
+void FsyncPath(const std::string& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(path + ": cannot open (" + std::strerror(errno) + ")");
+  const int rc = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (rc != 0) throw std::runtime_error(path + ": fsync failed (" + std::strerror(error) + ")");
+}
+
+}  // namespace
+
+DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_normal().string()) {
+  for (const char* sub : {"scans", "jobs", "tmp"}) fs::create_directories(fs::path(root_) / sub);
+  const std::string lock_path = (fs::path(root_) / "lock").string();
+  lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0) {
+    throw std::runtime_error(lock_path + ": cannot open (" + std::strerror(errno) + ")");
+  }
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd_);
+    throw std::runtime_error(root_ + ": another boicpd is using this data directory");
+  }
+  // Leftovers of uploads that were in flight when a daemon died.
+  for (const auto& entry : fs::directory_iterator(fs::path(root_) / "tmp")) {
+    std::error_code ignored;
+    fs::remove_all(entry.path(), ignored);
+  }
+}
+
+DataDir::~DataDir() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // closing releases the flock
+}
+
+std::string DataDir::DatabasePath() const { return (fs::path(root_) / "boicpd.sqlite").string(); }
+
+std::string DataDir::ScanPath(const std::string& scan_id) const {
+  return (fs::path(root_) / "scans" / scan_id.substr(0, 2) / scan_id).string();
+}
+
+bool DataDir::HasScanFile(const std::string& scan_id) const {
+  std::error_code ec;
+  return fs::is_regular_file(ScanPath(scan_id), ec);
+}
+
+std::string DataDir::JobDir(const std::string& job_id) const {
+  return (fs::path(root_) / "jobs" / job_id).string();
+}
+
+std::string DataDir::NewTempPath() {
+  return (fs::path(root_) / "tmp" /
+          ("upload-" + std::to_string(::getpid()) + "-" + std::to_string(temp_counter_++)))
+      .string();
+}
+
+void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) const {
+  const fs::path target = ScanPath(scan_id);
+  fs::create_directories(target.parent_path());
+  FsyncPath(tmp_path, O_RDONLY);
+  fs::rename(tmp_path, target);
+  FsyncPath(target.parent_path().string(), O_RDONLY | O_DIRECTORY);
+}
+
+}  // namespace boicp::server

@@ -1,0 +1,173 @@
+#include "job_manager.hpp"
+
+#include <algorithm>
+
+#include <omp.h>
+#include <spdlog/spdlog.h>
+
+#include "job_spec.hpp"
+#include "proto_convert.hpp"
+#include "service_error.hpp"
+
+namespace boicp::server {
+
+JobManager::JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
+                       const ManagerOptions& options)
+    : store_(store), data_dir_(data_dir), events_(events), options_(options) {
+  const int omp_threads = options_.registration_threads;
+  // OpenMP regions inside the engine and Open3D take this thread's limit, so
+  // workers x registration threads is the whole registration load.
+  pool_ = std::make_unique<ThreadPool>(options_.workers,
+                                       [omp_threads] { omp_set_num_threads(omp_threads); });
+  context_ = std::make_unique<RunnerContext>(RunnerContext{
+      store_, data_dir_, *pool_, events_, options_.registration_threads, options_.workers});
+}
+
+JobManager::~JobManager() { Drain(); }
+
+void JobManager::Start() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (v1::Job& job : store_.UnfinishedJobs()) {
+    if (job.cancel_requested()) {
+      // Cancelled while a previous daemon ran it: finish the cancellation.
+      job.set_state(v1::JOB_STATE_CANCELLED);
+      job.set_stage("cancelled");
+      job.set_finished_at(NowSeconds());
+      store_.UpdateJob(job);
+      Publish(job);
+      spdlog::info("job {} cancelled (requested before the restart)", job.job_id());
+      continue;
+    }
+    spdlog::info("job {} resumes: {} of {} pairs done before the restart", job.job_id(),
+                 job.pairs_done(), job.pairs_total());
+    queue_.push_back(job.job_id());
+    Publish(job);
+  }
+  accepting_ = true;
+  for (int i = 0; i < std::max(options_.concurrent_jobs, 1); ++i) {
+    slots_.emplace_back([this] { RunSlot(); });
+  }
+}
+
+v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
+  if (request.scan_ids_size() > options_.max_batch_scans) {
+    throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                       "scan_ids: " + std::to_string(request.scan_ids_size()) +
+                           " scans is over this daemon's limit of " +
+                           std::to_string(options_.max_batch_scans) + " (--max-batch-scans)");
+  }
+  JobInput input;
+  input.request = request;
+  for (int i = 0; i < request.scan_ids_size(); ++i) {
+    const std::optional<StoredScan> scan = store_.GetScan(request.scan_ids(i));
+    if (!scan || !data_dir_.HasScanFile(request.scan_ids(i))) {
+      throw InputError("scan_ids[" + std::to_string(i) + "]: unknown scan id '" +
+                       request.scan_ids(i) + "' (upload it first)");
+    }
+    input.scans.push_back(scan->metadata);
+  }
+  const JobSpec spec =
+      BuildJobSpec("new", request, input.scans, data_dir_, options_.registration_threads);
+
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!accepting_) {
+    throw ServiceError(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down");
+  }
+  if (static_cast<int>(queue_.size()) >= options_.max_queued_jobs) {
+    throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                       "the queue is full: " + std::to_string(queue_.size()) +
+                           " jobs wait (--max-queued-jobs " +
+                           std::to_string(options_.max_queued_jobs) + ")");
+  }
+  v1::Job job;
+  job.set_label(request.label());
+  job.set_state(v1::JOB_STATE_QUEUED);
+  job.set_stage("queued");
+  job.set_num_scans(static_cast<uint32_t>(request.scan_ids_size()));
+  const size_t planned = spec.pairing == PairingMode::kKeyframes
+                             ? spec.scans.size() - 1 + spec.extra_pairs.size()
+                             : spec.base_pairs.size() + spec.extra_pairs.size();
+  job.set_pairs_total(static_cast<uint32_t>(planned));
+  job.set_eta_seconds(-1.0);
+  job.set_created_at(NowSeconds());
+  job = store_.CreateJob(job, input);
+  queue_.push_back(job.job_id());
+  queue_changed_.notify_one();
+  Publish(job);
+  spdlog::info("job {} queued: {} scans, {} pairs planned, preset {}, label '{}'", job.job_id(),
+               job.num_scans(), job.pairs_total(), spec.config.preset, job.label());
+  return job;
+}
+
+v1::Job JobManager::Cancel(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::optional<v1::Job> job = store_.GetJob(job_id);
+  if (!job) throw ServiceError(grpc::StatusCode::NOT_FOUND, "no job '" + job_id + "'");
+  if (const auto queued = std::find(queue_.begin(), queue_.end(), job_id); queued != queue_.end()) {
+    queue_.erase(queued);
+    job->set_state(v1::JOB_STATE_CANCELLED);
+    job->set_stage("cancelled");
+    job->set_cancel_requested(true);
+    job->set_finished_at(NowSeconds());
+    job->set_eta_seconds(-1.0);
+    store_.UpdateJob(*job);
+    Publish(*job);
+    spdlog::info("job {} cancelled while queued", job_id);
+    return *job;
+  }
+  if (const auto running = running_.find(job_id); running != running_.end()) {
+    running->second->Cancel();
+    // Stored so that a daemon killed before the job stops still cancels it.
+    job->set_cancel_requested(true);
+    store_.UpdateJob(*job);
+    spdlog::info("job {} cancel requested", job_id);
+  }
+  return *job;
+}
+
+void JobManager::Drain() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    accepting_ = false;
+    if (draining_) return;
+    draining_ = true;
+    for (auto& [id, control] : running_) control->Interrupt();
+  }
+  queue_changed_.notify_all();
+  for (std::thread& slot : slots_) slot.join();
+  slots_.clear();
+  pool_.reset();  // every task has returned: each runner waited for its own
+}
+
+void JobManager::RunSlot() {
+  for (;;) {
+    std::string job_id;
+    std::shared_ptr<JobControl> control;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      queue_changed_.wait(lock, [this] { return draining_ || !queue_.empty(); });
+      if (draining_) return;
+      job_id = queue_.front();
+      queue_.pop_front();
+      control = std::make_shared<JobControl>();
+      running_[job_id] = control;
+    }
+    std::optional<v1::Job> job;
+    try {
+      job = store_.GetJob(job_id);
+    } catch (const std::exception& e) {
+      spdlog::error("job {}: cannot read it from the data store: {}", job_id, e.what());
+    }
+    if (job) RunJob(*context_, *control, *job);
+    std::lock_guard<std::mutex> lock(mutex_);
+    running_.erase(job_id);
+  }
+}
+
+void JobManager::Publish(const v1::Job& job) {
+  v1::JobEvent event;
+  *event.mutable_job() = job;
+  events_.Publish(event);
+}
+
+}  // namespace boicp::server

@@ -1,0 +1,82 @@
+#pragma once
+// The job queue: accepts batches, runs up to `concurrent_jobs` of them at a
+// time on job-slot threads (their pairs on one shared worker pool), cancels,
+// resumes what a previous daemon left unfinished, and drains on shutdown.
+
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "boicp/v1/map_builder.pb.h"
+#include "data_dir.hpp"
+#include "job_events.hpp"
+#include "job_runner.hpp"
+#include "job_store.hpp"
+#include "thread_pool.hpp"
+
+namespace boicp::server {
+
+namespace v1 = ::boicp::v1;
+
+struct ManagerOptions {
+  int workers = 1;               // pool threads: pair registrations running at once
+  int concurrent_jobs = 1;       // jobs running at once (each also fuses its map on its slot)
+  int registration_threads = 1;  // threads inside one registration
+  int max_queued_jobs = 64;      // queued (not yet running) jobs; more is RESOURCE_EXHAUSTED
+  int max_batch_scans = 100000;  // scans per batch; more is RESOURCE_EXHAUSTED
+};
+
+class JobManager {
+ public:
+  JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
+             const ManagerOptions& options);
+  /// Drains if Drain() was not called.
+  ~JobManager();
+  JobManager(const JobManager&) = delete;
+  JobManager& operator=(const JobManager&) = delete;
+
+  /// Queues every job a previous daemon left queued or running, then starts
+  /// the job slots.
+  void Start();
+
+  /// Validates and queues a batch; returns the queued job. Throws
+  /// InputError (bad batch), ServiceError RESOURCE_EXHAUSTED (limits) or
+  /// UNAVAILABLE (draining).
+  v1::Job Submit(const v1::SubmitBatchRequest& request);
+
+  /// Cancels a queued job at once, asks a running one to stop (its state
+  /// turns CANCELLED within seconds), and leaves a finished one as it is.
+  /// Throws ServiceError NOT_FOUND.
+  v1::Job Cancel(const std::string& job_id);
+
+  /// Stops accepting, interrupts running jobs (finished pairs are already
+  /// stored; they stay resumable) and joins every thread. Idempotent.
+  void Drain();
+
+ private:
+  void RunSlot();
+  void Publish(const v1::Job& job);
+
+  JobStore& store_;
+  DataDir& data_dir_;
+  JobEventSink& events_;
+  ManagerOptions options_;
+  std::unique_ptr<ThreadPool> pool_;
+  std::unique_ptr<RunnerContext> context_;
+
+  std::mutex mutex_;
+  std::condition_variable queue_changed_;
+  std::deque<std::string> queue_;
+  std::map<std::string, std::shared_ptr<JobControl>> running_;
+  bool accepting_ = false;
+  bool draining_ = false;
+  std::vector<std::thread> slots_;
+};
+
+}  // namespace boicp::server

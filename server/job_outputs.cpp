@@ -1,0 +1,32 @@
+#include "job_outputs.hpp"
+
+namespace boicp::server {
+
+std::optional<std::string> ExportFileName(int format) {
+  switch (format) {
+    case ::boicp::v1::EXPORT_FORMAT_OCTOMAP_BT:
+      return "map.bt";
+    case ::boicp::v1::EXPORT_FORMAT_OCTOMAP_OT:
+      return "map.ot";
+    case ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_TUM:
+      return "trajectory.tum";
+    case ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_KITTI:
+      return "trajectory.kitti";
+    case ::boicp::v1::EXPORT_FORMAT_POINT_CLOUD_PLY:
+      return "map.ply";
+    default:
+      return std::nullopt;
+  }
+}
+
+MapOutputPaths JobOutputPaths(const std::string& job_dir) {
+  MapOutputPaths paths;
+  paths.octomap_bt = job_dir + "/map.bt";
+  paths.octomap_ot = job_dir + "/map.ot";
+  paths.trajectory_tum = job_dir + "/trajectory.tum";
+  paths.trajectory_kitti = job_dir + "/trajectory.kitti";
+  paths.cloud_ply = job_dir + "/map.ply";
+  return paths;
+}
+
+}  // namespace boicp::server

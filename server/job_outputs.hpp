@@ -1,0 +1,19 @@
+#pragma once
+// Names of the files a finished job leaves in its directory, per export format.
+
+#include <optional>
+#include <string>
+
+#include "boicp/map_assembly.hpp"
+#include "boicp/v1/map_builder.pb.h"
+
+namespace boicp::server {
+
+/// "map.bt", "map.ot", "trajectory.tum", "trajectory.kitti" or "map.ply";
+/// nullopt for a format value that is not one of the five.
+std::optional<std::string> ExportFileName(int format);
+
+/// Every output of a job, under `job_dir`.
+MapOutputPaths JobOutputPaths(const std::string& job_dir);
+
+}  // namespace boicp::server

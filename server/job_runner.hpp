@@ -1,0 +1,55 @@
+#pragma once
+// Runs one job: its pair registrations on the shared pool (skipping pairs a
+// previous run of the daemon finished), then map assembly on the calling
+// thread. Every finished pair is stored before it is reported, so a daemon
+// killed at any point resumes with only the unfinished pairs.
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+
+#include "boicp/v1/map_builder.pb.h"
+#include "data_dir.hpp"
+#include "job_events.hpp"
+#include "job_store.hpp"
+#include "thread_pool.hpp"
+
+namespace boicp::server {
+
+struct RunnerContext {
+  JobStore& store;
+  DataDir& data_dir;
+  ThreadPool& pool;
+  JobEventSink& events;
+  int registration_threads = 1;
+  int max_pairs_in_flight = 1;  // per job, so concurrent jobs share the pool
+};
+
+/// Stop requests for a running job, shared by the manager, the runner and
+/// the job's pair tasks (which poll it between ICP evaluations).
+class JobControl {
+ public:
+  /// The user cancelled: the job ends CANCELLED.
+  void Cancel();
+  /// The daemon drains: the job stops but stays resumable.
+  void Interrupt();
+  bool cancelled() const { return cancelled_; }
+  bool interrupted() const { return interrupted_; }
+  bool StopRequested() const { return cancelled_ || interrupted_; }
+
+  std::mutex mutex;                 // guards the runner's completion queue
+  std::condition_variable changed;  // a pair finished or a stop was requested
+
+ private:
+  std::atomic<bool> cancelled_{false};
+  std::atomic<bool> interrupted_{false};
+};
+
+enum class RunOutcome { kSucceeded, kFailed, kCancelled, kInterrupted };
+
+/// Runs or resumes `job` until it succeeds, fails or is cancelled (recorded
+/// in the store and published), or until an interrupt, which leaves it
+/// RUNNING in the store for the next daemon to resume. Never throws.
+RunOutcome RunJob(const RunnerContext& context, JobControl& control, ::boicp::v1::Job job);
+
+}  // namespace boicp::server

@@ -1,0 +1,47 @@
+#pragma once
+// A job as the runner needs it, built from the stored request and the
+// snapshot of its scans' metadata. The same function validates a batch at
+// submission and rebuilds it when a restarted daemon resumes the job, so
+// both see the same configuration.
+
+#include <string>
+#include <vector>
+
+#include "boicp/config.hpp"
+#include "boicp/map_assembly.hpp"
+#include "boicp/map_pairs.hpp"
+#include "boicp/v1/map_builder.pb.h"
+#include "data_dir.hpp"
+
+namespace boicp::server {
+
+namespace v1 = ::boicp::v1;
+
+enum class PairingMode { kConsecutive, kKeyframes, kExplicit };
+
+struct JobSpec {
+  std::string job_id;
+  std::vector<std::string> scan_ids;
+  std::vector<ScanSource> scans;
+  PairingMode pairing = PairingMode::kConsecutive;
+  double overlap_threshold = 0.7;      // kKeyframes only
+  std::vector<PairIndex> base_pairs;   // consecutive or explicit pairs; empty for keyframes
+  std::vector<PairIndex> extra_pairs;  // loop closures on top of the policy's pairs
+  BoIcpConfig config;                  // config.seed is the job seed
+  MapBuildSettings map;
+};
+
+/// Preset plus overrides, validated. `threads` is the daemon's setting for
+/// threads inside one registration. Throws InputError naming the field.
+BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads);
+
+/// Map settings with defaults for zero fields, validated. Throws InputError.
+MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto);
+
+/// Validates everything about a batch except that its scans exist (the
+/// caller looked them up to get `scans`). Throws InputError naming the field.
+JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& request,
+                     const std::vector<v1::ScanMetadata>& scans, const DataDir& data_dir,
+                     int registration_threads);
+
+}  // namespace boicp::server

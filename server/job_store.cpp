@@ -1,0 +1,292 @@
+#include "job_store.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <set>
+
+#include "boicp/types.hpp"
+
+namespace boicp::server {
+namespace {
+
+constexpr const char* kSchema = R"sql(
+CREATE TABLE IF NOT EXISTS scans (
+  scan_id TEXT PRIMARY KEY,
+  num_points INTEGER NOT NULL,
+  metadata BLOB NOT NULL
+);
+CREATE TABLE IF NOT EXISTS jobs (
+  seq INTEGER PRIMARY KEY,
+  job_id TEXT NOT NULL UNIQUE,
+  state INTEGER NOT NULL,
+  job BLOB NOT NULL,
+  request BLOB NOT NULL
+);
+CREATE INDEX IF NOT EXISTS jobs_state ON jobs (state);
+CREATE TABLE IF NOT EXISTS job_scans (
+  job_id TEXT NOT NULL,
+  idx INTEGER NOT NULL,
+  metadata BLOB NOT NULL,
+  PRIMARY KEY (job_id, idx)
+);
+CREATE TABLE IF NOT EXISTS pair_results (
+  job_id TEXT NOT NULL,
+  source INTEGER NOT NULL,
+  target INTEGER NOT NULL,
+  plan_order INTEGER NOT NULL,
+  result BLOB NOT NULL,
+  information BLOB NOT NULL,
+  PRIMARY KEY (job_id, source, target)
+);
+CREATE TABLE IF NOT EXISTS trajectories (
+  job_id TEXT NOT NULL,
+  idx INTEGER NOT NULL,
+  pose BLOB NOT NULL,
+  PRIMARY KEY (job_id, idx)
+);
+)sql";
+
+std::string Serialize(const google::protobuf::MessageLite& message) {
+  std::string bytes;
+  if (!message.SerializeToString(&bytes)) throw std::runtime_error("protobuf: serialize failed");
+  return bytes;
+}
+
+template <typename Message>
+Message Parse(const std::string& bytes, const char* what) {
+  Message message;
+  if (!message.ParseFromString(bytes)) {
+    throw std::runtime_error(std::string("data store: corrupt ") + what + " record");
+  }
+  return message;
+}
+
+std::string InformationBytes(const InformationMatrix& information) {
+  std::string bytes(sizeof(double) * 36, '\0');
+  std::memcpy(bytes.data(), information.data(), bytes.size());
+  return bytes;
+}
+
+InformationMatrix InformationFromBytes(const std::string& bytes) {
+  InformationMatrix information = InformationMatrix::Identity();
+  if (bytes.size() == sizeof(double) * 36)
+    std::memcpy(information.data(), bytes.data(), bytes.size());
+  return information;
+}
+
+std::string JobIdForSeq(int64_t seq) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "job-%06lld", static_cast<long long>(seq));
+  return buffer;
+}
+
+}  // namespace
+
+JobStore::JobStore(const std::string& path) : db_(path) {
+  // WAL lets readers run beside the writer; FULL syncs every commit, so an
+  // acknowledged upload or finished pair survives even a power cut.
+  db_.Exec("PRAGMA journal_mode=WAL");
+  db_.Exec("PRAGMA synchronous=FULL");
+  db_.Exec("PRAGMA foreign_keys=ON");
+  db_.Exec(kSchema);
+}
+
+void JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Prepare(
+         "INSERT INTO scans (scan_id, num_points, metadata) VALUES (?1, ?2, ?3) "
+         "ON CONFLICT (scan_id) DO UPDATE SET num_points = ?2, metadata = ?3")
+      .Bind(1, metadata.sha256())
+      .Bind(2, static_cast<int64_t>(num_points))
+      .BindBlob(3, Serialize(metadata))
+      .Run();
+}
+
+std::optional<StoredScan> JobStore::GetScan(const std::string& scan_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare("SELECT num_points, metadata FROM scans WHERE scan_id = ?1");
+  stmt.Bind(1, scan_id);
+  if (!stmt.Step()) return std::nullopt;
+  StoredScan scan;
+  scan.num_points = static_cast<uint64_t>(stmt.ColumnInt(0));
+  scan.metadata = Parse<v1::ScanMetadata>(stmt.ColumnBlob(1), "scan");
+  return scan;
+}
+
+v1::Job JobStore::CreateJob(v1::Job job, const JobInput& input) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  SqliteDatabase::Transaction transaction(db_);
+  auto next = db_.Prepare("SELECT COALESCE(MAX(seq), 0) + 1 FROM jobs");
+  next.Step();
+  const int64_t seq = next.ColumnInt(0);
+  job.set_job_id(JobIdForSeq(seq));
+  db_.Prepare("INSERT INTO jobs (seq, job_id, state, job, request) VALUES (?1, ?2, ?3, ?4, ?5)")
+      .Bind(1, seq)
+      .Bind(2, job.job_id())
+      .Bind(3, static_cast<int64_t>(job.state()))
+      .BindBlob(4, Serialize(job))
+      .BindBlob(5, Serialize(input.request))
+      .Run();
+  auto insert_scan =
+      db_.Prepare("INSERT INTO job_scans (job_id, idx, metadata) VALUES (?1, ?2, ?3)");
+  for (size_t i = 0; i < input.scans.size(); ++i) {
+    insert_scan.Bind(1, job.job_id())
+        .Bind(2, static_cast<int64_t>(i))
+        .BindBlob(3, Serialize(input.scans[i]))
+        .Run();
+    insert_scan.Reset();
+  }
+  transaction.Commit();
+  return job;
+}
+
+void JobStore::UpdateJob(const v1::Job& job) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Prepare("UPDATE jobs SET state = ?2, job = ?3 WHERE job_id = ?1")
+      .Bind(1, job.job_id())
+      .Bind(2, static_cast<int64_t>(job.state()))
+      .BindBlob(3, Serialize(job))
+      .Run();
+}
+
+std::optional<v1::Job> JobStore::GetJob(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare("SELECT job FROM jobs WHERE job_id = ?1");
+  stmt.Bind(1, job_id);
+  if (!stmt.Step()) return std::nullopt;
+  return Parse<v1::Job>(stmt.ColumnBlob(0), "job");
+}
+
+std::optional<JobInput> JobStore::GetJobInput(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare("SELECT request FROM jobs WHERE job_id = ?1");
+  stmt.Bind(1, job_id);
+  if (!stmt.Step()) return std::nullopt;
+  JobInput input;
+  input.request = Parse<v1::SubmitBatchRequest>(stmt.ColumnBlob(0), "job request");
+  auto scans = db_.Prepare("SELECT metadata FROM job_scans WHERE job_id = ?1 ORDER BY idx");
+  scans.Bind(1, job_id);
+  while (scans.Step()) input.scans.push_back(Parse<v1::ScanMetadata>(scans.ColumnBlob(0), "scan"));
+  return input;
+}
+
+JobPage JobStore::ListJobs(int page_size, const std::string& page_token) {
+  int64_t before = INT64_MAX;
+  if (!page_token.empty()) {
+    size_t used = 0;
+    try {
+      before = std::stoll(page_token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != page_token.size() || before <= 0) {
+      throw InputError("page_token: not a token from a previous ListJobs response");
+    }
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare("SELECT seq, job FROM jobs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2");
+  stmt.Bind(1, before).Bind(2, static_cast<int64_t>(page_size) + 1);
+  JobPage page;
+  int64_t last_seq = 0;
+  while (stmt.Step()) {
+    if (static_cast<int>(page.jobs.size()) == page_size) {
+      page.next_page_token = std::to_string(last_seq);
+      break;
+    }
+    last_seq = stmt.ColumnInt(0);
+    page.jobs.push_back(Parse<v1::Job>(stmt.ColumnBlob(1), "job"));
+  }
+  return page;
+}
+
+std::vector<v1::Job> JobStore::UnfinishedJobs() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare("SELECT job FROM jobs WHERE state IN (?1, ?2) ORDER BY seq");
+  stmt.Bind(1, static_cast<int64_t>(v1::JOB_STATE_QUEUED))
+      .Bind(2, static_cast<int64_t>(v1::JOB_STATE_RUNNING));
+  std::vector<v1::Job> jobs;
+  while (stmt.Step()) jobs.push_back(Parse<v1::Job>(stmt.ColumnBlob(0), "job"));
+  return jobs;
+}
+
+void JobStore::PutPair(const std::string& job_id, int plan_order, const v1::PairResult& result,
+                       const InformationMatrix& information) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Prepare(
+         "INSERT OR REPLACE INTO pair_results (job_id, source, target, plan_order, result, "
+         "information) VALUES (?1, ?2, ?3, ?4, ?5, ?6)")
+      .Bind(1, job_id)
+      .Bind(2, static_cast<int64_t>(result.source()))
+      .Bind(3, static_cast<int64_t>(result.target()))
+      .Bind(4, static_cast<int64_t>(plan_order))
+      .BindBlob(5, Serialize(result))
+      .BindBlob(6, InformationBytes(information))
+      .Run();
+}
+
+std::vector<StoredPair> JobStore::GetPairs(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare(
+      "SELECT result, information FROM pair_results WHERE job_id = ?1 "
+      "ORDER BY plan_order, source, target");
+  stmt.Bind(1, job_id);
+  std::vector<StoredPair> pairs;
+  while (stmt.Step()) {
+    StoredPair pair;
+    pair.result = Parse<v1::PairResult>(stmt.ColumnBlob(0), "pair");
+    pair.information = InformationFromBytes(stmt.ColumnBlob(1));
+    pairs.push_back(std::move(pair));
+  }
+  return pairs;
+}
+
+void JobStore::MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph) {
+  const std::set<PairIndex> wanted(in_graph.begin(), in_graph.end());
+  std::vector<StoredPair> pairs = GetPairs(job_id);
+  std::lock_guard<std::mutex> lock(mutex_);
+  SqliteDatabase::Transaction transaction(db_);
+  for (StoredPair& pair : pairs) {
+    const PairIndex index{static_cast<int>(pair.result.source()),
+                          static_cast<int>(pair.result.target())};
+    pair.result.set_in_graph(wanted.count(index) > 0);
+    db_.Prepare(
+           "UPDATE pair_results SET result = ?4 WHERE job_id = ?1 AND source = ?2 AND target = ?3")
+        .Bind(1, job_id)
+        .Bind(2, static_cast<int64_t>(index.source))
+        .Bind(3, static_cast<int64_t>(index.target))
+        .BindBlob(4, Serialize(pair.result))
+        .Run();
+  }
+  transaction.Commit();
+}
+
+void JobStore::PutTrajectory(const std::string& job_id,
+                             const std::vector<v1::TrajectoryPose>& poses) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  SqliteDatabase::Transaction transaction(db_);
+  db_.Prepare("DELETE FROM trajectories WHERE job_id = ?1").Bind(1, job_id).Run();
+  for (const v1::TrajectoryPose& pose : poses) {
+    db_.Prepare("INSERT INTO trajectories (job_id, idx, pose) VALUES (?1, ?2, ?3)")
+        .Bind(1, job_id)
+        .Bind(2, static_cast<int64_t>(pose.index()))
+        .BindBlob(3, Serialize(pose))
+        .Run();
+  }
+  transaction.Commit();
+}
+
+std::vector<v1::TrajectoryPose> JobStore::GetTrajectory(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto stmt = db_.Prepare("SELECT pose FROM trajectories WHERE job_id = ?1 ORDER BY idx");
+  stmt.Bind(1, job_id);
+  std::vector<v1::TrajectoryPose> poses;
+  while (stmt.Step()) poses.push_back(Parse<v1::TrajectoryPose>(stmt.ColumnBlob(0), "pose"));
+  return poses;
+}
+
+void JobStore::Checkpoint() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Exec("PRAGMA wal_checkpoint(TRUNCATE)");
+}
+
+}  // namespace boicp::server

@@ -1,0 +1,82 @@
+#pragma once
+// Durable state of the daemon in SQLite (WAL, synchronous=FULL): scans'
+// metadata, jobs with their normalised request and a snapshot of their
+// scans' metadata, finished pair results and trajectories. Every write is
+// its own transaction, so a daemon killed at any moment loses nothing it
+// acknowledged. Thread-safe: one connection behind a mutex.
+
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/pose_graph.hpp"
+#include "boicp/v1/map_builder.pb.h"
+#include "sqlite_db.hpp"
+
+namespace boicp::server {
+
+namespace v1 = ::boicp::v1;
+
+struct StoredScan {
+  v1::ScanMetadata metadata;  // sha256 holds the scan id
+  uint64_t num_points = 0;
+};
+
+/// What a job needs to run, as accepted at submission.
+struct JobInput {
+  v1::SubmitBatchRequest request;
+  std::vector<v1::ScanMetadata> scans;  // one per request.scan_ids entry
+};
+
+struct StoredPair {
+  v1::PairResult result;
+  InformationMatrix information = InformationMatrix::Identity();
+};
+
+struct JobPage {
+  std::vector<v1::Job> jobs;
+  std::string next_page_token;
+};
+
+class JobStore {
+ public:
+  /// Opens or creates the database and its schema. Throws std::runtime_error.
+  explicit JobStore(const std::string& path);
+
+  void PutScan(const v1::ScanMetadata& metadata, uint64_t num_points);
+  std::optional<StoredScan> GetScan(const std::string& scan_id);
+
+  /// Assigns the job id ("job-000001", ...) and stores the job and its
+  /// input in one transaction. Returns the job with its id set.
+  v1::Job CreateJob(v1::Job job, const JobInput& input);
+  void UpdateJob(const v1::Job& job);
+  std::optional<v1::Job> GetJob(const std::string& job_id);
+  std::optional<JobInput> GetJobInput(const std::string& job_id);
+  /// Newest first. `page_token` is opaque (empty = first page); throws
+  /// InputError for a token this store did not hand out.
+  JobPage ListJobs(int page_size, const std::string& page_token);
+  /// Queued and running jobs, oldest first: the work a restarted daemon resumes.
+  std::vector<v1::Job> UnfinishedJobs();
+
+  /// Stores one finished pair (replacing an earlier result for the same pair).
+  void PutPair(const std::string& job_id, int plan_order, const v1::PairResult& result,
+               const InformationMatrix& information);
+  /// In plan order.
+  std::vector<StoredPair> GetPairs(const std::string& job_id);
+  /// Sets in_graph on every stored pair of the job: true exactly for `in_graph`.
+  void MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph);
+
+  void PutTrajectory(const std::string& job_id, const std::vector<v1::TrajectoryPose>& poses);
+  std::vector<v1::TrajectoryPose> GetTrajectory(const std::string& job_id);
+
+  /// Moves the WAL into the main file (on a clean shutdown).
+  void Checkpoint();
+
+ private:
+  std::mutex mutex_;
+  SqliteDatabase db_;
+};
+
+}  // namespace boicp::server

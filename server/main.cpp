@@ -1,0 +1,86 @@
+// boicpd: the BO-ICP map-building daemon (gRPC API boicp.v1.MapBuilder).
+
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <climits>
+
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+
+#include <open3d/utility/Logging.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+
+#include "daemon.hpp"
+#include "daemon_options.hpp"
+
+namespace {
+
+// libgomp reads OMP_* variables when it is loaded, before main, so setting
+// one here only takes effect in a fresh image of this program. Spinning
+// OpenMP workers would steal the cores of concurrent registrations, so the
+// daemon re-executes itself once with the passive wait policy unless the
+// user chose a policy.
+void EnsurePassiveOpenMp(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+  setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0);
+  // The resolved path keeps the process name "boicpd" (not "exe").
+  char self[PATH_MAX];
+  const ssize_t length = ::readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (length <= 0) return;  // no /proc: run on, with OpenMP's default policy
+  self[length] = '\0';
+  ::execv(self, argv);
+}
+
+sigset_t ShutdownSignals() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  return signals;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  EnsurePassiveOpenMp(argv);
+  CLI::App app{"boicpd: BO-ICP map-building daemon (gRPC)"};
+  app.set_version_flag("--version", "boicpd 0.1.0");
+  boicp::server::DaemonOptions options;
+  boicp::server::AddDaemonOptions(app, options);
+  try {
+    app.parse(argc, argv);
+    boicp::server::ValidateDaemonOptions(options);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "boicpd: error: " << e.what() << std::endl;
+    return 2;
+  }
+
+  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
+  spdlog::set_level(spdlog::level::from_str(options.log_level));
+  spdlog::flush_on(spdlog::level::trace);
+  open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Warning);
+
+  // Every thread inherits this mask, so the signals wait for sigwait below
+  // instead of interrupting an arbitrary thread.
+  const sigset_t signals = ShutdownSignals();
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  ::signal(SIGPIPE, SIG_IGN);
+
+  try {
+    boicp::server::Daemon daemon(options);
+    int signal_number = 0;
+    sigwait(&signals, &signal_number);
+    spdlog::info("received {}", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+    daemon.Shutdown();
+  } catch (const std::exception& e) {
+    spdlog::error("boicpd: {}", e.what());
+    return 1;
+  }
+  return 0;
+}

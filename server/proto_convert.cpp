@@ -1,0 +1,117 @@
+#include "proto_convert.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace boicp::server {
+
+Transform TransformFromProto(const v1::Transform& proto, const std::string& field) {
+  if (proto.m_size() != 16) {
+    throw InputError(field + ": a transform has 16 numbers (row-major 4x4), got " +
+                     std::to_string(proto.m_size()));
+  }
+  Transform T;
+  for (int i = 0; i < 16; ++i) {
+    if (!std::isfinite(proto.m(i))) throw InputError(field + ": non-finite entry");
+    T(i / 4, i % 4) = proto.m(i);
+  }
+  constexpr double kTolerance = 1e-3;
+  if (std::abs(T(3, 0)) > kTolerance || std::abs(T(3, 1)) > kTolerance ||
+      std::abs(T(3, 2)) > kTolerance || std::abs(T(3, 3) - 1.0) > kTolerance) {
+    throw InputError(field + ": the last row must be 0 0 0 1");
+  }
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > kTolerance ||
+      R.determinant() < 0.0) {
+    throw InputError(field + ": the rotation part is not a rotation (orthonormal, det +1)");
+  }
+  T.row(3) << 0.0, 0.0, 0.0, 1.0;
+  return T;
+}
+
+void TransformToProto(const Transform& T, v1::Transform* proto) {
+  proto->clear_m();
+  for (int i = 0; i < 16; ++i) proto->add_m(T(i / 4, i % 4));
+}
+
+Point PointFromProto(const v1::Vector3& proto, const std::string& field) {
+  const Point p(proto.x(), proto.y(), proto.z());
+  if (!p.allFinite()) throw InputError(field + ": non-finite value");
+  return p;
+}
+
+CloudFormat FormatFromProto(int format) {
+  switch (format) {
+    case v1::SCAN_FORMAT_KITTI_BIN:
+      return CloudFormat::kKittiBin;
+    case v1::SCAN_FORMAT_PCD:
+      return CloudFormat::kPcd;
+    case v1::SCAN_FORMAT_PLY:
+      return CloudFormat::kPly;
+    case v1::SCAN_FORMAT_XYZ:
+      return CloudFormat::kXyz;
+    case v1::SCAN_FORMAT_DEPTH_PNG:
+      return CloudFormat::kDepthPng;
+    case v1::SCAN_FORMAT_UNSPECIFIED:
+      throw InputError("metadata.format is required (kitti_bin, pcd, ply, xyz or depth_png)");
+    default:
+      throw InputError("metadata.format: unknown scan format " + std::to_string(format));
+  }
+}
+
+LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata) {
+  LoadOptions options;
+  options.format = FormatFromProto(metadata.format());
+  if (options.format != CloudFormat::kDepthPng) return options;
+  if (!metadata.has_depth()) {
+    throw InputError("metadata.depth: a depth image needs intrinsics and depth_scale");
+  }
+  const v1::DepthCamera& d = metadata.depth();
+  if (!(d.fx() > 0.0 && d.fy() > 0.0) || !std::isfinite(d.fx()) || !std::isfinite(d.fy()) ||
+      !std::isfinite(d.cx()) || !std::isfinite(d.cy())) {
+    throw InputError("metadata.depth: fx and fy must be positive, cx and cy finite");
+  }
+  if (!(d.depth_scale() > 0.0) || !std::isfinite(d.depth_scale())) {
+    throw InputError("metadata.depth.depth_scale must be positive (TUM 5000, 7-Scenes 1000)");
+  }
+  options.depth.intrinsics = Intrinsics{d.fx(), d.fy(), d.cx(), d.cy()};
+  options.depth.depth_scale = d.depth_scale();
+  if (d.invalid_values_size() > 0) {
+    options.depth.invalid_values.clear();
+    for (uint32_t v : d.invalid_values()) {
+      if (v > 65535) throw InputError("metadata.depth.invalid_values must be in 0..65535");
+      options.depth.invalid_values.push_back(static_cast<uint16_t>(v));
+    }
+  }
+  return options;
+}
+
+bool IsTerminal(v1::JobState state) {
+  return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
+         state == v1::JOB_STATE_CANCELLED;
+}
+
+std::string JobStateName(v1::JobState state) {
+  switch (state) {
+    case v1::JOB_STATE_QUEUED:
+      return "queued";
+    case v1::JOB_STATE_RUNNING:
+      return "running";
+    case v1::JOB_STATE_SUCCEEDED:
+      return "succeeded";
+    case v1::JOB_STATE_FAILED:
+      return "failed";
+    case v1::JOB_STATE_CANCELLED:
+      return "cancelled";
+    default:
+      return "unspecified";
+  }
+}
+
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace boicp::server

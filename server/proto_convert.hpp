@@ -1,0 +1,38 @@
+#pragma once
+// Conversions between the boicp.v1 messages and core types, with the
+// validation of what a client sent (every failure is an InputError naming
+// the field).
+
+#include <string>
+
+#include "boicp/point_cloud_io.hpp"
+#include "boicp/types.hpp"
+#include "boicp/v1/map_builder.pb.h"
+
+namespace boicp::server {
+
+namespace v1 = ::boicp::v1;
+
+/// A rigid transform: 16 finite numbers, last row 0 0 0 1, orthonormal
+/// rotation with determinant +1 (tolerance 1e-3). Throws InputError naming `field`.
+Transform TransformFromProto(const v1::Transform& proto, const std::string& field);
+void TransformToProto(const Transform& T, v1::Transform* proto);
+
+/// Throws InputError naming `field` unless all three are finite.
+Point PointFromProto(const v1::Vector3& proto, const std::string& field);
+
+/// Throws InputError for SCAN_FORMAT_UNSPECIFIED or a value this daemon does not know.
+CloudFormat FormatFromProto(int format);
+
+/// Format and depth options to load a stored scan with. Throws InputError
+/// when a depth image lacks intrinsics or scale.
+LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata);
+
+bool IsTerminal(v1::JobState state);
+/// "queued", "running", "succeeded", "failed", "cancelled".
+std::string JobStateName(v1::JobState state);
+
+/// Seconds since the Unix epoch, for the *_at fields.
+double NowSeconds();
+
+}  // namespace boicp::server

@@ -1,0 +1,175 @@
+#include "service.hpp"
+
+#include <algorithm>
+
+#include "export_reactor.hpp"
+#include "job_outputs.hpp"
+#include "proto_convert.hpp"
+#include "service_error.hpp"
+#include "upload_reactor.hpp"
+
+namespace boicp::server {
+namespace {
+
+constexpr int kDefaultPageSize = 50;
+constexpr int kMaxPageSize = 500;
+constexpr int kMaxFindScans = 100000;
+
+// Runs a unary handler: authentication, then `handler`, whose exceptions
+// become the matching status.
+template <typename Handler>
+grpc::ServerUnaryReactor* Unary(const ServiceDeps& deps, grpc::CallbackServerContext* context,
+                                const char* rpc, Handler&& handler) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  grpc::Status status = deps.auth.Check(*context);
+  if (status.ok()) status = GuardRpc(rpc, std::forward<Handler>(handler));
+  reactor->Finish(status);
+  return reactor;
+}
+
+void RequireJobId(const std::string& job_id) {
+  if (job_id.empty()) throw InputError("job_id is required");
+}
+
+v1::Job RequireJob(const ServiceDeps& deps, const std::string& job_id) {
+  RequireJobId(job_id);
+  std::optional<v1::Job> job = FindJob(deps, job_id);
+  if (!job) throw ServiceError(grpc::StatusCode::NOT_FOUND, "no job '" + job_id + "'");
+  return *job;
+}
+
+// Writes one status and ends, for streams refused before they start.
+template <typename Message>
+class RejectedStream : public grpc::ServerWriteReactor<Message> {
+ public:
+  explicit RejectedStream(const grpc::Status& status) { this->Finish(status); }
+  void OnDone() override { delete this; }
+};
+
+}  // namespace
+
+std::optional<v1::Job> FindJob(const ServiceDeps& deps, const std::string& job_id) {
+  if (std::optional<v1::Job> latest = deps.watches.Latest(job_id)) return latest;
+  return deps.store.GetJob(job_id);
+}
+
+grpc::ServerReadReactor<v1::UploadScanRequest>* MapBuilderService::UploadScan(
+    grpc::CallbackServerContext* context, v1::UploadScanResponse* response) {
+  return new UploadReactor(deps_, response, deps_.auth.Check(*context));
+}
+
+grpc::ServerUnaryReactor* MapBuilderService::FindScans(grpc::CallbackServerContext* context,
+                                                       const v1::FindScansRequest* request,
+                                                       v1::FindScansResponse* response) {
+  return Unary(deps_, context, "FindScans", [&] {
+    if (request->scan_ids_size() > kMaxFindScans) {
+      throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                         "scan_ids: at most " + std::to_string(kMaxFindScans) + " per call");
+    }
+    for (const std::string& id : request->scan_ids()) {
+      if (!deps_.store.GetScan(id) || !deps_.data_dir.HasScanFile(id)) response->add_missing(id);
+    }
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* MapBuilderService::SubmitBatch(grpc::CallbackServerContext* context,
+                                                         const v1::SubmitBatchRequest* request,
+                                                         v1::Job* response) {
+  return Unary(deps_, context, "SubmitBatch", [&] {
+    *response = deps_.manager.Submit(*request);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* MapBuilderService::GetJob(grpc::CallbackServerContext* context,
+                                                    const v1::GetJobRequest* request,
+                                                    v1::Job* response) {
+  return Unary(deps_, context, "GetJob", [&] {
+    *response = RequireJob(deps_, request->job_id());
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* MapBuilderService::ListJobs(grpc::CallbackServerContext* context,
+                                                      const v1::ListJobsRequest* request,
+                                                      v1::ListJobsResponse* response) {
+  return Unary(deps_, context, "ListJobs", [&] {
+    const int size = request->page_size() == 0
+                         ? kDefaultPageSize
+                         : std::min(static_cast<int>(request->page_size()), kMaxPageSize);
+    JobPage page = deps_.store.ListJobs(size, request->page_token());
+    for (v1::Job& job : page.jobs) {
+      if (std::optional<v1::Job> latest = deps_.watches.Latest(job.job_id())) job = *latest;
+      *response->add_jobs() = std::move(job);
+    }
+    response->set_next_page_token(page.next_page_token);
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerUnaryReactor* MapBuilderService::CancelJob(grpc::CallbackServerContext* context,
+                                                       const v1::CancelJobRequest* request,
+                                                       v1::Job* response) {
+  return Unary(deps_, context, "CancelJob", [&] {
+    RequireJobId(request->job_id());
+    *response = deps_.manager.Cancel(request->job_id());
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerWriteReactor<v1::JobEvent>* MapBuilderService::WatchJob(
+    grpc::CallbackServerContext* context, const v1::WatchJobRequest* request) {
+  grpc::Status status = deps_.auth.Check(*context);
+  std::optional<v1::Job> stored;
+  if (status.ok()) {
+    status = GuardRpc("WatchJob", [&] {
+      RequireJobId(request->job_id());
+      stored = deps_.store.GetJob(request->job_id());
+      return grpc::Status::OK;
+    });
+  }
+  if (!status.ok()) return new RejectedStream<v1::JobEvent>(status);
+  return deps_.watches.StartWatch(request->job_id(), stored);
+}
+
+grpc::ServerUnaryReactor* MapBuilderService::GetResults(grpc::CallbackServerContext* context,
+                                                        const v1::GetResultsRequest* request,
+                                                        v1::JobResults* response) {
+  return Unary(deps_, context, "GetResults", [&] {
+    *response->mutable_job() = RequireJob(deps_, request->job_id());
+    for (const StoredPair& pair : deps_.store.GetPairs(request->job_id())) {
+      *response->add_pairs() = pair.result;
+    }
+    for (const v1::TrajectoryPose& pose : deps_.store.GetTrajectory(request->job_id())) {
+      *response->add_trajectory() = pose;
+    }
+    return grpc::Status::OK;
+  });
+}
+
+grpc::ServerWriteReactor<v1::ExportChunk>* MapBuilderService::Export(
+    grpc::CallbackServerContext* context, const v1::ExportRequest* request) {
+  grpc::Status status = deps_.auth.Check(*context);
+  std::string path, name;
+  if (status.ok()) {
+    status = GuardRpc("Export", [&] {
+      const v1::Job job = RequireJob(deps_, request->job_id());
+      const std::optional<std::string> file = ExportFileName(request->format());
+      if (!file)
+        throw InputError("format: unknown export format " + std::to_string(request->format()));
+      if (job.state() != v1::JOB_STATE_SUCCEEDED) {
+        throw ServiceError(grpc::StatusCode::FAILED_PRECONDITION,
+                           "job '" + job.job_id() + "' is " + JobStateName(job.state()) +
+                               "; its outputs exist once it has succeeded");
+      }
+      name = *file;
+      path = deps_.data_dir.JobDir(job.job_id()) + "/" + name;
+      return grpc::Status::OK;
+    });
+  }
+  if (!status.ok()) return new RejectedStream<v1::ExportChunk>(status);
+  return new ExportReactor(path, name);
+}
+
+}  // namespace boicp::server

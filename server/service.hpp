@@ -1,0 +1,63 @@
+#pragma once
+// The boicp.v1.MapBuilder service on gRPC's callback API. Handlers only
+// validate, read the store and queue work; jobs run on the job manager's
+// threads, never inside a handler, so Server::Shutdown is never blocked by one.
+
+#include <cstdint>
+
+#include "auth.hpp"
+#include "boicp/v1/map_builder.grpc.pb.h"
+#include "data_dir.hpp"
+#include "job_manager.hpp"
+#include "job_store.hpp"
+#include "watch_hub.hpp"
+
+namespace boicp::server {
+
+namespace v1 = ::boicp::v1;
+
+struct ServiceDeps {
+  JobStore& store;
+  DataDir& data_dir;
+  JobManager& manager;
+  WatchHub& watches;
+  const BearerAuth& auth;
+  uint64_t max_scan_bytes = 0;  // larger uploads are RESOURCE_EXHAUSTED
+};
+
+/// The freshest view of a job: the newest published snapshot, else the store.
+std::optional<v1::Job> FindJob(const ServiceDeps& deps, const std::string& job_id);
+
+class MapBuilderService final : public v1::MapBuilder::CallbackService {
+ public:
+  explicit MapBuilderService(const ServiceDeps& deps) : deps_(deps) {}
+
+  grpc::ServerReadReactor<v1::UploadScanRequest>* UploadScan(
+      grpc::CallbackServerContext* context, v1::UploadScanResponse* response) override;
+  grpc::ServerUnaryReactor* FindScans(grpc::CallbackServerContext* context,
+                                      const v1::FindScansRequest* request,
+                                      v1::FindScansResponse* response) override;
+  grpc::ServerUnaryReactor* SubmitBatch(grpc::CallbackServerContext* context,
+                                        const v1::SubmitBatchRequest* request,
+                                        v1::Job* response) override;
+  grpc::ServerUnaryReactor* GetJob(grpc::CallbackServerContext* context,
+                                   const v1::GetJobRequest* request, v1::Job* response) override;
+  grpc::ServerUnaryReactor* ListJobs(grpc::CallbackServerContext* context,
+                                     const v1::ListJobsRequest* request,
+                                     v1::ListJobsResponse* response) override;
+  grpc::ServerUnaryReactor* CancelJob(grpc::CallbackServerContext* context,
+                                      const v1::CancelJobRequest* request,
+                                      v1::Job* response) override;
+  grpc::ServerWriteReactor<v1::JobEvent>* WatchJob(grpc::CallbackServerContext* context,
+                                                   const v1::WatchJobRequest* request) override;
+  grpc::ServerUnaryReactor* GetResults(grpc::CallbackServerContext* context,
+                                       const v1::GetResultsRequest* request,
+                                       v1::JobResults* response) override;
+  grpc::ServerWriteReactor<v1::ExportChunk>* Export(grpc::CallbackServerContext* context,
+                                                    const v1::ExportRequest* request) override;
+
+ private:
+  ServiceDeps deps_;
+};
+
+}  // namespace boicp::server

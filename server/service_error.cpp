@@ -1,0 +1,25 @@
+#include "service_error.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "boicp/types.hpp"
+
+namespace boicp::server {
+
+grpc::Status StatusFromCurrentException(const char* rpc) {
+  try {
+    throw;
+  } catch (const ServiceError& e) {
+    return grpc::Status(e.code(), e.what());
+  } catch (const InputError& e) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const std::exception& e) {
+    spdlog::error("{}: internal error: {}", rpc, e.what());
+    return grpc::Status(grpc::StatusCode::INTERNAL, std::string("internal error: ") + e.what());
+  } catch (...) {
+    spdlog::error("{}: internal error of unknown type", rpc);
+    return grpc::Status(grpc::StatusCode::INTERNAL, "internal error");
+  }
+}
+
+}  // namespace boicp::server

@@ -1,0 +1,39 @@
+#pragma once
+// A fixed set of worker threads running tasks in FIFO order. Pair
+// registrations of every job share it, so its size is the daemon's
+// --workers setting and nothing else creates registration threads.
+
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace boicp::server {
+
+class ThreadPool {
+ public:
+  /// Starts `threads` workers (at least 1). `on_thread_start` runs once on
+  /// each worker before any task (to set per-thread limits such as OpenMP's).
+  explicit ThreadPool(int threads, std::function<void()> on_thread_start = {});
+  /// Runs the tasks already queued, then joins the workers.
+  ~ThreadPool();
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  void Submit(std::function<void()> task);
+  int size() const { return static_cast<int>(workers_.size()); }
+
+ private:
+  void Work();
+
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<std::function<void()>> tasks_;
+  bool stopping_ = false;
+  std::function<void()> on_thread_start_;
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace boicp::server

@@ -1,0 +1,168 @@
+#include "upload_reactor.hpp"
+
+#include <filesystem>
+
+#include <spdlog/spdlog.h>
+
+#include "proto_convert.hpp"
+#include "service.hpp"
+#include "service_error.hpp"
+
+namespace boicp::server {
+namespace {
+
+// Loader messages name the file; the client knows it as its upload.
+std::string WithoutPath(std::string message, const std::string& path) {
+  for (size_t at = message.find(path); at != std::string::npos; at = message.find(path)) {
+    message.replace(at, path.size(), "uploaded scan");
+  }
+  return message;
+}
+
+}  // namespace
+
+UploadReactor::UploadReactor(const ServiceDeps& deps, v1::UploadScanResponse* response,
+                             const grpc::Status& auth)
+    : deps_(deps), response_(response) {
+  if (!auth.ok()) {
+    Finish(auth);
+    return;
+  }
+  StartRead(&request_);
+}
+
+void UploadReactor::OnReadDone(bool ok) {
+  const grpc::Status status = GuardRpc("UploadScan", [&] {
+    if (ok) {
+      Accept(request_);
+    } else {
+      Complete();
+    }
+    return grpc::Status::OK;
+  });
+  if (!status.ok()) {
+    Finish(status);
+  } else if (ok) {
+    StartRead(&request_);
+  } else {
+    Finish(grpc::Status::OK);
+  }
+}
+
+void UploadReactor::OnDone() {
+  if (temp_.is_open()) temp_.close();
+  if (!temp_path_.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove(temp_path_, ignored);
+  }
+  delete this;
+}
+
+void UploadReactor::Accept(const v1::UploadScanRequest& request) {
+  switch (request.payload_case()) {
+    case v1::UploadScanRequest::kMetadata:
+      AcceptMetadata(request.metadata());
+      return;
+    case v1::UploadScanRequest::kChunk:
+      AcceptChunk(request.chunk());
+      return;
+    default:
+      throw InputError("an upload message carries metadata or a chunk");
+  }
+}
+
+void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
+  if (metadata_) throw InputError("metadata may only be sent once, first");
+  LoadOptionsFromMetadata(metadata);  // format and depth camera
+  if (metadata.has_sensor_origin())
+    PointFromProto(metadata.sensor_origin(), "metadata.sensor_origin");
+  if (metadata.has_prior_pose()) TransformFromProto(metadata.prior_pose(), "metadata.prior_pose");
+  if (!metadata.sha256().empty() && !IsSha256Hex(metadata.sha256())) {
+    throw InputError("metadata.sha256 must be 64 lowercase hex digits");
+  }
+  known_ = !metadata.sha256().empty() && deps_.store.GetScan(metadata.sha256()) &&
+           deps_.data_dir.HasScanFile(metadata.sha256());
+  if (!known_) {
+    if (metadata.size_bytes() == 0) {
+      throw InputError("metadata.size_bytes is required (the number of bytes that follow)");
+    }
+    if (metadata.size_bytes() > deps_.max_scan_bytes) {
+      throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                         "scan of " + std::to_string(metadata.size_bytes()) +
+                             " bytes is over this daemon's limit of " +
+                             std::to_string(deps_.max_scan_bytes) + " (--max-scan-bytes)");
+    }
+    temp_path_ = deps_.data_dir.NewTempPath();
+    temp_.open(temp_path_, std::ios::binary | std::ios::trunc);
+    if (!temp_) throw std::runtime_error(temp_path_ + ": cannot create");
+  }
+  metadata_ = metadata;
+}
+
+void UploadReactor::AcceptChunk(const std::string& bytes) {
+  if (!metadata_) throw InputError("the first upload message must carry metadata");
+  if (known_) return;  // the server has these bytes already
+  if (received_ + bytes.size() > metadata_->size_bytes()) {
+    throw InputError("more bytes than metadata.size_bytes (" +
+                     std::to_string(metadata_->size_bytes()) + ")");
+  }
+  temp_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!temp_) throw std::runtime_error(temp_path_ + ": write failed");
+  hash_.Update(bytes.data(), bytes.size());
+  received_ += bytes.size();
+}
+
+void UploadReactor::Complete() {
+  if (!metadata_) throw InputError("empty upload: send metadata, then the bytes");
+  v1::ScanMetadata metadata = *metadata_;
+  if (known_) {
+    // The new metadata must still describe the stored bytes (a format or
+    // camera change re-parses them, which is cheap next to an upload).
+    const std::string path = deps_.data_dir.ScanPath(metadata.sha256());
+    LoadedCloud cloud;
+    try {
+      cloud = LoadPointCloud(path, LoadOptionsFromMetadata(metadata));
+    } catch (const InputError& e) {
+      throw InputError(WithoutPath(e.what(), path));
+    }
+    metadata.set_size_bytes(deps_.store.GetScan(metadata.sha256())->metadata.size_bytes());
+    deps_.store.PutScan(metadata, cloud.points.size());
+    response_->set_scan_id(metadata.sha256());
+    response_->set_already_present(true);
+    response_->set_num_points(cloud.points.size());
+    response_->set_size_bytes(metadata.size_bytes());
+    spdlog::info("scan {} already stored; metadata updated", metadata.sha256().substr(0, 12));
+    return;
+  }
+  if (received_ != metadata.size_bytes()) {
+    throw InputError("received " + std::to_string(received_) + " bytes, metadata.size_bytes says " +
+                     std::to_string(metadata.size_bytes()));
+  }
+  temp_.close();
+  if (!temp_) throw std::runtime_error(temp_path_ + ": write failed");
+  const std::string id = hash_.HexDigest();
+  if (!metadata.sha256().empty() && metadata.sha256() != id) {
+    throw InputError("metadata.sha256 does not match the bytes received (got " + id + ")");
+  }
+  LoadedCloud cloud;
+  try {
+    cloud = LoadPointCloud(temp_path_, LoadOptionsFromMetadata(metadata));
+  } catch (const InputError& e) {
+    throw InputError(WithoutPath(e.what(), temp_path_));
+  }
+  const bool present = deps_.data_dir.HasScanFile(id);
+  if (!present) {
+    deps_.data_dir.CommitScan(temp_path_, id);
+    temp_path_.clear();
+  }
+  metadata.set_sha256(id);
+  deps_.store.PutScan(metadata, cloud.points.size());
+  response_->set_scan_id(id);
+  response_->set_already_present(present);
+  response_->set_num_points(cloud.points.size());
+  response_->set_size_bytes(metadata.size_bytes());
+  spdlog::info("scan {} stored: {} bytes, {} points", id.substr(0, 12), metadata.size_bytes(),
+               cloud.points.size());
+}
+
+}  // namespace boicp::server

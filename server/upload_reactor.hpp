@@ -1,0 +1,46 @@
+#pragma once
+// UploadScan: metadata first, then the bytes in chunks, written to a temp
+// file and hashed as they arrive. At the end the scan is parsed with the
+// core loaders (so a malformed scan is refused at upload, not mid-batch),
+// then renamed to its hash and recorded.
+
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include <grpcpp/support/server_callback.h>
+
+#include "boicp/v1/map_builder.pb.h"
+#include "sha256.hpp"
+
+namespace boicp::server {
+
+struct ServiceDeps;
+
+class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequest> {
+ public:
+  /// Finishes at once with `auth` unless it is OK.
+  UploadReactor(const ServiceDeps& deps, ::boicp::v1::UploadScanResponse* response,
+                const grpc::Status& auth);
+
+  void OnReadDone(bool ok) override;
+  void OnDone() override;
+
+ private:
+  void Accept(const ::boicp::v1::UploadScanRequest& request);
+  void AcceptMetadata(const ::boicp::v1::ScanMetadata& metadata);
+  void AcceptChunk(const std::string& bytes);
+  void Complete();
+
+  const ServiceDeps& deps_;
+  ::boicp::v1::UploadScanResponse* response_;
+  ::boicp::v1::UploadScanRequest request_;
+  std::optional<::boicp::v1::ScanMetadata> metadata_;
+  bool known_ = false;  // the client named a hash the store holds: bytes are not needed
+  std::string temp_path_;
+  std::ofstream temp_;
+  Sha256 hash_;
+  uint64_t received_ = 0;
+};
+
+}  // namespace boicp::server

@@ -1,0 +1,83 @@
+#include "server_fixture.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "demo_sequence.hpp"
+
+namespace boicp::test {
+
+v1::SubmitBatchRequest QuickBatch(const std::vector<std::string>& scan_ids, uint64_t seed) {
+  v1::SubmitBatchRequest request;
+  for (const std::string& id : scan_ids) request.add_scan_ids(id);
+  request.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_CONSECUTIVE);
+  v1::RegistrationConfig& config = *request.mutable_config();
+  config.set_preset("A");
+  config.set_random_samples(4);
+  config.set_iterations(4);
+  config.set_seed(seed);
+  config.mutable_rotation_bounds()->set_x(0.2);
+  config.mutable_rotation_bounds()->set_y(0.2);
+  config.mutable_rotation_bounds()->set_z(M_PI);
+  request.mutable_map()->set_resolution(0.3);
+  request.mutable_map()->set_max_range(30.0);
+  request.set_label("test");
+  return request;
+}
+
+void ServerTest::SetUp() {
+  dir_ = std::filesystem::temp_directory_path() /
+         ("boicpd_test_" + std::to_string(::getpid()) + "_" +
+          ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::remove_all(dir_);
+  std::filesystem::create_directories(dir_);
+}
+
+void ServerTest::TearDown() {
+  if (daemon_ && HasFailure()) {
+    std::cerr << "---- boicpd log ----\n" << daemon_->Log() << "--------------------\n";
+  }
+  daemon_.reset();
+  std::filesystem::remove_all(dir_);
+}
+
+void ServerTest::StartDaemon(const std::vector<std::string>& args) {
+  daemon_.reset();
+  std::vector<std::string> all = {"--data-dir", (dir_ / "data").string()};
+  all.insert(all.end(), args.begin(), args.end());
+  daemon_ = std::make_unique<DaemonProcess>(
+      all, (dir_ / ("boicpd." + std::to_string(starts_++) + ".log")).string());
+}
+
+client::MapBuilderClient ServerTest::Client(const std::string& token) const {
+  client::ConnectOptions options;
+  options.address = daemon_->address();
+  return client::MapBuilderClient(client::Connect(options), token);
+}
+
+std::vector<std::string> ServerTest::UploadDrive(client::MapBuilderClient& client, int n,
+                                                 uint64_t seed, std::vector<Transform>* truth) {
+  std::vector<std::string> ids;
+  for (const auto& scan : client::MakeDemoSequence(n, seed)) {
+    v1::ScanMetadata metadata;
+    metadata.set_format(v1::SCAN_FORMAT_KITTI_BIN);
+    ids.push_back(client.Upload(scan.kitti_bytes, metadata).scan_id());
+    if (truth) truth->push_back(scan.T_world_scan);
+  }
+  return ids;
+}
+
+v1::Job ServerTest::PollJob(client::MapBuilderClient& client, const std::string& job_id,
+                            const std::function<bool(const v1::Job&)>& done, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  v1::Job job = client.GetJob(job_id);
+  while (!done(job) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    job = client.GetJob(job_id);
+  }
+  return job;
+}
+
+}  // namespace boicp::test

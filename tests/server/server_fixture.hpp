@@ -1,0 +1,51 @@
+#pragma once
+// What every daemon test shares: a temporary folder, a daemon process on a
+// free loopback port, a client, and quick batches of a generated drive.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "boicp/types.hpp"
+#include "daemon_process.hpp"
+#include "map_builder_client.hpp"
+
+namespace boicp::test {
+
+namespace v1 = ::boicp::v1;
+
+/// Settings that keep a generated-drive batch to about a second a pair on
+/// this machine: preset A cut to 4 + 4 evaluations per stage, ground-vehicle
+/// rotation bounds. The scans overlap so much that this is still exact.
+v1::SubmitBatchRequest QuickBatch(const std::vector<std::string>& scan_ids, uint64_t seed = 3);
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override;
+  void TearDown() override;
+
+  /// Starts (or restarts) the daemon on the test's data directory with
+  /// `args` after --data-dir. Default workers: 2, one registration thread.
+  void StartDaemon(const std::vector<std::string>& args = {"--workers", "2"});
+  void StopDaemon() { daemon_.reset(); }
+
+  client::MapBuilderClient Client(const std::string& token = "") const;
+
+  /// Uploads a generated drive of `n` scans; returns their ids and, in
+  /// `truth`, their poses.
+  std::vector<std::string> UploadDrive(client::MapBuilderClient& client, int n, uint64_t seed,
+                                       std::vector<Transform>* truth = nullptr);
+
+  /// Polls GetJob every 50 ms until `done(job)` or `timeout_s`; returns the last job.
+  v1::Job PollJob(client::MapBuilderClient& client, const std::string& job_id,
+                  const std::function<bool(const v1::Job&)>& done, double timeout_s);
+
+  std::filesystem::path dir_;
+  std::unique_ptr<DaemonProcess> daemon_;
+  int starts_ = 0;
+};
+
+}  // namespace boicp::test

@@ -1,0 +1,195 @@
+// Every bad input of the issue gets its precise status, and the daemon stays
+// up: INVALID_ARGUMENT, NOT_FOUND, RESOURCE_EXHAUSTED, UNAUTHENTICATED.
+
+#include <fstream>
+
+#include <gmock/gmock.h>
+
+#include "server_fixture.hpp"
+
+namespace boicp::test {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Uploads raw messages: `metadata`, then `chunks`. Returns the final status.
+grpc::Status RawUpload(client::MapBuilderClient& client, const v1::ScanMetadata& metadata,
+                       const std::vector<std::string>& chunks, const std::string& token = "") {
+  grpc::ClientContext context;
+  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+  v1::UploadScanResponse response;
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = metadata;
+  bool open = writer->Write(message);
+  for (const std::string& chunk : chunks) {
+    if (!open) break;
+    message.set_chunk(chunk);
+    open = writer->Write(message);
+  }
+  writer->WritesDone();
+  return writer->Finish();
+}
+
+v1::ScanMetadata Meta(v1::ScanFormat format, size_t size) {
+  v1::ScanMetadata metadata;
+  metadata.set_format(format);
+  metadata.set_size_bytes(size);
+  return metadata;
+}
+
+template <typename Call>
+grpc::StatusCode CodeOf(Call&& call) {
+  try {
+    call();
+  } catch (const client::RpcError& e) {
+    return e.code();
+  }
+  return grpc::StatusCode::OK;
+}
+
+class BadInput : public ServerTest {};
+
+TEST_F(BadInput, EachCaseGetsItsStatusAndTheDaemonStaysUp) {
+  StartDaemon({"--workers", "1", "--jobs", "1", "--max-queued-jobs", "1", "--max-scan-bytes",
+               "3000000", "--max-message-bytes", "2000000", "--max-batch-scans", "10"});
+  auto client = Client();
+  using Code = grpc::StatusCode;
+
+  // --- Uploads ---------------------------------------------------------------
+  const std::string seventeen(17, 'x');
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_KITTI_BIN, 17), {seventeen}).error_code(),
+            Code::INVALID_ARGUMENT)
+      << "malformed (truncated) KITTI scan";
+  const std::string comment_only = "# no points at all\n";
+  const grpc::Status empty =
+      RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, comment_only.size()), {comment_only});
+  EXPECT_EQ(empty.error_code(), Code::INVALID_ARGUMENT) << "empty cloud";
+  EXPECT_THAT(empty.error_message(), HasSubstr("uploaded scan"));
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_UNSPECIFIED, 3), {"abc"}).error_code(),
+            Code::INVALID_ARGUMENT)
+      << "no format";
+  EXPECT_EQ(RawUpload(client, Meta(static_cast<v1::ScanFormat>(42), 3), {"abc"}).error_code(),
+            Code::INVALID_ARGUMENT)
+      << "unknown format";
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_DEPTH_PNG, 3), {"abc"}).error_code(),
+            Code::INVALID_ARGUMENT)
+      << "depth image without intrinsics";
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_PLY, 3), {"abc"}).error_code(),
+            Code::INVALID_ARGUMENT)
+      << "malformed PLY";
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, 10), {"1 2 3\n"}).error_code(),
+            Code::INVALID_ARGUMENT)
+      << "fewer bytes than announced";
+  v1::ScanMetadata wrong_hash = Meta(v1::SCAN_FORMAT_XYZ, 6);
+  wrong_hash.set_sha256(std::string(64, 'a'));
+  EXPECT_EQ(RawUpload(client, wrong_hash, {"1 2 3\n"}).error_code(), Code::INVALID_ARGUMENT)
+      << "hash mismatch";
+  v1::ScanMetadata bad_prior = Meta(v1::SCAN_FORMAT_XYZ, 6);
+  for (int k = 0; k < 16; ++k) bad_prior.mutable_prior_pose()->add_m(2.0);
+  EXPECT_EQ(RawUpload(client, bad_prior, {"1 2 3\n"}).error_code(), Code::INVALID_ARGUMENT)
+      << "prior pose that is not rigid";
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_KITTI_BIN, 4000000), {}).error_code(),
+            Code::RESOURCE_EXHAUSTED)
+      << "scan over --max-scan-bytes";
+  EXPECT_EQ(RawUpload(client, Meta(v1::SCAN_FORMAT_KITTI_BIN, 2500000), {std::string(2500000, 0)})
+                .error_code(),
+            Code::RESOURCE_EXHAUSTED)
+      << "message over --max-message-bytes";
+
+  // --- Batches ---------------------------------------------------------------
+  const auto ids = UploadDrive(client, 3, 81);
+  auto submit_code = [&](const v1::SubmitBatchRequest& request) {
+    return CodeOf([&] { client.Submit(request); });
+  };
+  v1::SubmitBatchRequest unknown = QuickBatch(ids);
+  unknown.set_scan_ids(1, std::string(64, 'f'));
+  EXPECT_EQ(submit_code(unknown), Code::INVALID_ARGUMENT) << "unknown scan id";
+  EXPECT_EQ(submit_code(QuickBatch({ids[0]})), Code::INVALID_ARGUMENT) << "one scan";
+  v1::SubmitBatchRequest bad_voxel = QuickBatch(ids);
+  bad_voxel.mutable_config()->set_voxel(-1.0);
+  EXPECT_EQ(submit_code(bad_voxel), Code::INVALID_ARGUMENT) << "negative voxel";
+  v1::SubmitBatchRequest bad_preset = QuickBatch(ids);
+  bad_preset.mutable_config()->set_preset("Z");
+  EXPECT_EQ(submit_code(bad_preset), Code::INVALID_ARGUMENT) << "unknown preset";
+  v1::SubmitBatchRequest bad_bounds = QuickBatch(ids);
+  bad_bounds.mutable_config()->mutable_rotation_bounds()->set_x(-0.1);
+  EXPECT_EQ(submit_code(bad_bounds), Code::INVALID_ARGUMENT) << "negative bounds";
+  v1::SubmitBatchRequest bad_pairs = QuickBatch(ids);
+  bad_pairs.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_EXPLICIT);
+  bad_pairs.mutable_pairing()->add_pairs()->set_target(1);
+  EXPECT_EQ(submit_code(bad_pairs), Code::INVALID_ARGUMENT) << "pairs leave scan 2 unconnected";
+  v1::SubmitBatchRequest bad_map = QuickBatch(ids);
+  bad_map.mutable_map()->set_resolution(-0.1);
+  EXPECT_EQ(submit_code(bad_map), Code::INVALID_ARGUMENT) << "negative resolution";
+  v1::SubmitBatchRequest bad_threshold = QuickBatch(ids);
+  bad_threshold.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  bad_threshold.mutable_pairing()->set_overlap_threshold(1.5);
+  EXPECT_EQ(submit_code(bad_threshold), Code::INVALID_ARGUMENT) << "overlap threshold";
+  std::vector<std::string> eleven(11, ids[0]);
+  EXPECT_EQ(submit_code(QuickBatch(eleven)), Code::RESOURCE_EXHAUSTED) << "--max-batch-scans";
+
+  // --- Unknown jobs ----------------------------------------------------------
+  EXPECT_EQ(CodeOf([&] { client.GetJob("job-999999"); }), Code::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] { client.Cancel("job-999999"); }), Code::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] { client.Results("job-999999"); }), Code::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] { client.Watch("job-999999"); }), Code::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] {
+              client.ExportToFile("job-999999", v1::EXPORT_FORMAT_OCTOMAP_BT,
+                                  (dir_ / "x").string());
+            }),
+            Code::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] { client.GetJob(""); }), Code::INVALID_ARGUMENT);
+
+  // --- Queue depth: one job runs, one waits, the third is refused -------------
+  v1::SubmitBatchRequest slow = QuickBatch(ids);
+  slow.mutable_config()->set_preset("C");
+  slow.mutable_config()->clear_random_samples();
+  slow.mutable_config()->clear_iterations();
+  const std::string first = client.Submit(slow).job_id();
+  PollJob(
+      client, first, [](const v1::Job& j) { return j.state() == v1::JOB_STATE_RUNNING; }, 30);
+  const std::string second = client.Submit(slow).job_id();
+  EXPECT_EQ(submit_code(slow), Code::RESOURCE_EXHAUSTED) << "--max-queued-jobs 1";
+  EXPECT_EQ(CodeOf([&] {
+              client.ExportToFile(first, static_cast<v1::ExportFormat>(77), (dir_ / "x").string());
+            }),
+            Code::INVALID_ARGUMENT)
+      << "unknown export format";
+  client.Cancel(second);
+  client.Cancel(first);
+
+  // Still serving after all of that.
+  EXPECT_EQ(client.GetJob(first).job_id(), first);
+  EXPECT_EQ(daemon_->Wait(0.1), -1) << "the daemon exited";
+}
+
+TEST_F(BadInput, BearerTokenIsRequiredWhenConfigured) {
+  const std::string token_file = (dir_ / "token").string();
+  std::ofstream(token_file) << "s3cret-token\n";
+  StartDaemon({"--workers", "1", "--auth-token-file", token_file});
+  auto anonymous = Client();
+  auto wrong = Client("not-the-token");
+  auto right = Client("s3cret-token");
+  using Code = grpc::StatusCode;
+
+  for (auto* client : {&anonymous, &wrong}) {
+    EXPECT_EQ(CodeOf([&] { client->GetJob("job-000001"); }), Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] { client->Submit(QuickBatch({"a", "b"})); }), Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] { client->Watch("job-000001"); }), Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] {
+                client->ExportToFile("job-000001", v1::EXPORT_FORMAT_OCTOMAP_BT,
+                                     (dir_ / "x").string());
+              }),
+              Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] { client->Upload("1 2 3\n", Meta(v1::SCAN_FORMAT_XYZ, 6)); }),
+              Code::UNAUTHENTICATED);
+  }
+  EXPECT_EQ(RawUpload(anonymous, Meta(v1::SCAN_FORMAT_XYZ, 6), {"1 2 3\n"}).error_code(),
+            Code::UNAUTHENTICATED);
+  EXPECT_EQ(CodeOf([&] { right.GetJob("job-000001"); }), Code::NOT_FOUND);
+  EXPECT_EQ(right.Upload("1 2 3\n4 5 6\n", Meta(v1::SCAN_FORMAT_XYZ, 0)).num_points(), 2u);
+}
+
+}  // namespace
+}  // namespace boicp::test

@@ -1,0 +1,100 @@
+// Pairing policies and seeds (core/map_pairs): the daemon's plan of work.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "boicp/map_pairs.hpp"
+#include "boicp/types.hpp"
+
+namespace boicp {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MapPairs, ConsecutivePairsRunSourceIOntoTargetINext) {
+  EXPECT_THAT(ConsecutivePairs(4), ElementsAre(PairIndex{0, 1}, PairIndex{1, 2}, PairIndex{2, 3}));
+  EXPECT_TRUE(ConsecutivePairs(1).empty());
+}
+
+TEST(MapPairs, ValidatePairsNamesTheProblem) {
+  EXPECT_THAT(ErrorOf([] { ValidatePairs(3, {{0, 3}}, false); }), HasSubstr("out of range"));
+  EXPECT_THAT(ErrorOf([] { ValidatePairs(3, {{1, 1}}, false); }), HasSubstr("itself"));
+  EXPECT_THAT(ErrorOf([] {
+                ValidatePairs(3, {{0, 1}, {1, 0}}, false);
+              }),
+              HasSubstr("already paired"));
+  EXPECT_THAT(ErrorOf([] {
+                ValidatePairs(4, {{0, 1}, {2, 3}}, true);
+              }),
+              HasSubstr("do not connect scan 2"));
+  EXPECT_EQ(ErrorOf([] { ValidatePairs(4, {{0, 1}, {2, 3}}, false); }), "");
+  EXPECT_EQ(ErrorOf([] { ValidatePairs(4, {{1, 0}, {2, 1}, {3, 0}}, true); }), "");
+}
+
+TEST(MapPairs, PairSeedDependsOnJobSeedAndPairOnly) {
+  EXPECT_EQ(PairSeed(5, {1, 2}), PairSeed(5, {1, 2}));
+  EXPECT_NE(PairSeed(5, {1, 2}), PairSeed(5, {2, 1}));
+  EXPECT_NE(PairSeed(5, {1, 2}), PairSeed(6, {1, 2}));
+}
+
+TEST(MapPairs, DefaultOverlapThresholdsAreThePapers) {
+  EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(CloudFormat::kKittiBin), 0.7);
+  EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(CloudFormat::kDepthPng), 0.6);
+}
+
+// Feeds the planner fitness values from a table until it is done.
+std::vector<PairIndex> RunPlanner(int scans, double threshold,
+                                  const std::function<double(PairIndex)>& fitness, int window,
+                                  std::vector<PairIndex>* probed = nullptr) {
+  KeyframePlanner planner(scans, threshold);
+  for (int guard = 0; guard < 1000 && !planner.Done(); ++guard) {
+    const auto probes = planner.NextProbes(window);
+    if (probes.empty()) ADD_FAILURE() << "planner stalled";
+    for (const PairIndex& p : probes) {
+      if (probed) probed->push_back(p);
+      planner.Record(p, fitness(p));
+    }
+  }
+  return planner.ChainPairs();
+}
+
+TEST(KeyframePlanner, NewKeyframeWhenOverlapDropsBelowThreshold) {
+  // Overlap falls by 0.15 per scan of distance: scans 1 and 2 see keyframe 0
+  // well enough (0.85, 0.7), scan 3 does not (0.55), so 2 becomes the keyframe.
+  const auto fitness = [](PairIndex p) { return 1.0 - 0.15 * std::abs(p.source - p.target); };
+  EXPECT_THAT(RunPlanner(6, 0.7, fitness, 1),
+              ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}, PairIndex{4, 2},
+                          PairIndex{5, 4}));
+}
+
+TEST(KeyframePlanner, SameChainWhateverTheWindow) {
+  const auto fitness = [](PairIndex p) { return 1.0 - 0.1 * std::abs(p.source - p.target); };
+  const auto one = RunPlanner(9, 0.75, fitness, 1);
+  EXPECT_EQ(RunPlanner(9, 0.75, fitness, 4), one);
+  EXPECT_EQ(RunPlanner(9, 0.75, fitness, 16), one);
+  EXPECT_EQ(one.size(), 8u);
+}
+
+TEST(KeyframePlanner, AdjacentScanIsKeptEvenWithLowOverlap) {
+  const auto fitness = [](PairIndex) { return 0.1; };
+  EXPECT_THAT(RunPlanner(3, 0.7, fitness, 2), ElementsAre(PairIndex{1, 0}, PairIndex{2, 1}));
+}
+
+TEST(KeyframePlanner, RejectsBadArguments) {
+  EXPECT_THROW(KeyframePlanner(0, 0.7), InputError);
+  EXPECT_THROW(KeyframePlanner(3, 0.0), InputError);
+  EXPECT_THROW(KeyframePlanner(3, 1.5), InputError);
+}
+
+}  // namespace
+}  // namespace boicp
