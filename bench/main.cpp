@@ -1,9 +1,6 @@
 // boicp-bench: BO-ICP against its baselines on reference pairs (issue #3).
 // Exit codes: 0 done, 2 bad command line or unreadable input.
 
-#include <unistd.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <set>
@@ -13,6 +10,7 @@
 #include "bench_options.hpp"
 #include "bench_pairs.hpp"
 #include "bench_run.hpp"
+#include "boicp/openmp_policy.hpp"
 #include "thread_budget.hpp"
 
 namespace {
@@ -41,21 +39,10 @@ std::vector<boicp::bench::DatasetPairs> ReadDatasets(const boicp::bench::BenchOp
   return datasets;
 }
 
-// libgomp reads OMP_WAIT_POLICY once, when it loads. Its default spins at
-// every barrier, and on a shared 2-core machine a spinning thread starves the
-// team member it waits for: ICP's short parallel loops then ran 5-10x slower
-// with 2 threads than with 1. So unless the caller chose a policy, restart
-// once with PASSIVE (threads sleep at barriers); the summary states it.
-void RestartWithPassiveWaitPolicy(char** argv) {
-  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
-  ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
-  ::execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  RestartWithPassiveWaitPolicy(argv);
+  boicp::RestartWithPassiveOpenMpWait(argv);
   boicp::bench::BenchOptions options;
   std::vector<boicp::bench::DatasetPairs> datasets;
   try {

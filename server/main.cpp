@@ -2,11 +2,7 @@
 
 #include <pthread.h>
 #include <signal.h>
-#include <unistd.h>
 
-#include <climits>
-
-#include <cstdlib>
 #include <cstring>
 #include <iostream>
 
@@ -14,26 +10,11 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "boicp/openmp_policy.hpp"
 #include "daemon.hpp"
 #include "daemon_options.hpp"
 
 namespace {
-
-// libgomp reads OMP_* variables when it is loaded, before main, so setting
-// one here only takes effect in a fresh image of this program. Spinning
-// OpenMP workers would steal the cores of concurrent registrations, so the
-// daemon re-executes itself once with the passive wait policy unless the
-// user chose a policy.
-void EnsurePassiveOpenMp(char** argv) {
-  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
-  setenv("OMP_WAIT_POLICY", "PASSIVE", /*overwrite=*/0);
-  // The resolved path keeps the process name "boicpd" (not "exe").
-  char self[PATH_MAX];
-  const ssize_t length = ::readlink("/proc/self/exe", self, sizeof(self) - 1);
-  if (length <= 0) return;  // no /proc: run on, with OpenMP's default policy
-  self[length] = '\0';
-  ::execv(self, argv);
-}
 
 sigset_t ShutdownSignals() {
   sigset_t signals;
@@ -46,7 +27,7 @@ sigset_t ShutdownSignals() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  EnsurePassiveOpenMp(argv);
+  boicp::RestartWithPassiveOpenMpWait(argv);
   CLI::App app{"boicpd: BO-ICP map-building daemon (gRPC)"};
   app.set_version_flag("--version", "boicpd 0.1.0");
   boicp::server::DaemonOptions options;
