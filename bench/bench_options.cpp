@@ -100,6 +100,7 @@ std::string UsageText() {
          "  --scaling NAME[,NAME...]  also time bo-C against points and iterations\n"
          "                            on the first pair of these datasets\n"
          "  --synthetic N             add N generated street pairs (no files needed)\n"
+         "  --scaling-only            only the scaling study of the --scaling datasets\n"
          "  --quick                   smoke-test budgets (see summary.md)\n";
 }
 
@@ -156,6 +157,10 @@ BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
       options.quick = true;
       continue;
     }
+    if (flag == "--scaling-only") {
+      options.scaling_only = true;
+      continue;
+    }
     if (flag == "--help" || flag == "-h") {
       options.help = true;
       return options;
@@ -182,6 +187,9 @@ BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
     throw UsageError("no pairs: give --pairs CSV, --datasets NAME or --synthetic N");
   }
   if (options.out_dir.empty()) throw UsageError("--out DIR is required");
+  if (options.scaling_only && options.scaling_datasets.empty()) {
+    throw UsageError("--scaling-only needs --scaling NAME");
+  }
   return options;
 }
 

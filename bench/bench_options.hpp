@@ -44,6 +44,7 @@ struct BenchOptions {
   int synthetic_pairs = 0;
   bool quick = false;
   std::vector<std::string> scaling_datasets;  // dataset names to run the scaling study on
+  bool scaling_only = false;                  // run the scaling study and skip the suite
   std::string command_line;
   bool help = false;
 };

@@ -46,7 +46,7 @@ class BenchRun {
   int Run() {
     std::cout << "boicp-bench\n" << FormatRunConditions(info_) << std::endl;
     for (const DatasetPairs& dataset : datasets_) {
-      const size_t count = PairCount(dataset);
+      const size_t count = options_.scaling_only ? 0 : PairCount(dataset);
       for (size_t index = 0; index < count; ++index) {
         const BenchPair pair = Load(dataset, index);
         const PairEvaluator evaluator(pair, dataset.settings);

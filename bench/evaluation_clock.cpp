@@ -21,7 +21,10 @@ RegistrationCallbacks EvaluationClock::Callbacks() {
     const double now = Now();
     if (progress.stage == "refine") {
       if (progress.done == 0) refine_start_ = now;
-      if (progress.done == 1 && refine_start_ >= 0.0) split_.refine_s = now - refine_start_;
+      // Every candidate refined counts, not only the first.
+      if (progress.done == progress.total && refine_start_ >= 0.0) {
+        split_.refine_s = now - refine_start_;
+      }
     } else if (last_poll_ >= 0.0) {
       split_.icp_s += now - last_poll_;
       last_poll_ = -1.0;

@@ -3,9 +3,9 @@
 #include <optional>
 
 #include "boicp/bo_icp.hpp"
+#include "dataset_config.hpp"
 #include "evaluation_clock.hpp"
 #include "methods.hpp"
-#include "shared_stages.hpp"
 
 namespace boicp::bench {
 

@@ -12,8 +12,9 @@
 #include <open3d/pipelines/registration/Registration.h>
 #include <open3d/utility/Random.h>
 
+#include "boicp/refinement.hpp"
+#include "dataset_config.hpp"
 #include "methods.hpp"
-#include "shared_stages.hpp"
 
 namespace boicp::bench {
 namespace {
@@ -46,7 +47,7 @@ MethodOutput Refined(const Transform& initial, const FeatureCloud& source,
   const BoIcpConfig config = DatasetBoConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
   MethodOutput output;
-  output.transform = RefineCoarseToFine(initial, pair, config);
+  output.transform = RefineCoarseToFine(initial, pair, config).transform;
   output.evaluations = 1;
   output.source_points = source.cloud->points_.size();
   output.target_points = target.cloud->points_.size();

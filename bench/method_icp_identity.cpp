@@ -1,17 +1,20 @@
 // icp-identity: plain ICP started from the identity, the baseline that shows
 // how far the perturbation is outside ICP's basin.
 
+#include "boicp/refinement.hpp"
+#include "dataset_config.hpp"
 #include "methods.hpp"
-#include "shared_stages.hpp"
 
 namespace boicp::bench {
 
 MethodOutput RunIcpFromIdentity(const MethodInput& input) {
   const BoIcpConfig config = DatasetBoConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
-  const Transform coarse = SearchIcp(Transform::Identity(), pair, config);
+  const Transform coarse = AlignPointToPoint(pair.search_source, pair.search_target,
+                                             Transform::Identity(), SearchIcpOptions(config))
+                               .transform;
   MethodOutput output;
-  output.transform = RefineCoarseToFine(coarse, pair, config);
+  output.transform = RefineCoarseToFine(coarse, pair, config).transform;
   output.evaluations = 1;
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();

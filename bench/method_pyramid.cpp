@@ -13,9 +13,10 @@
 
 #include "boicp/alignment_score.hpp"
 #include "boicp/preprocess.hpp"
+#include "boicp/refinement.hpp"
 #include "boicp/search_space.hpp"
+#include "dataset_config.hpp"
 #include "methods.hpp"
-#include "shared_stages.hpp"
 
 namespace boicp::bench {
 namespace {
@@ -158,7 +159,10 @@ MethodOutput RunPyramid(const MethodInput& input) {
   Transform best = Transform::Identity();
   double best_objective = std::numeric_limits<double>::infinity();
   for (const Candidate& candidate : translations) {
-    const Transform T = SearchIcp(translation_space.ToTransform(candidate.u), pair, config);
+    const Transform T =
+        AlignPointToPoint(pair.search_source, pair.search_target,
+                          translation_space.ToTransform(candidate.u), SearchIcpOptions(config))
+            .transform;
     const double objective =
         ScoreAlignment(pair.search_source, pair.search_target, T, gate, input.threads)
             .truncated_mean;
@@ -169,7 +173,7 @@ MethodOutput RunPyramid(const MethodInput& input) {
   }
 
   MethodOutput output;
-  output.transform = RefineCoarseToFine(best, pair, config);
+  output.transform = RefineCoarseToFine(best, pair, config).transform;
   output.evaluations = scorer.evaluations() + static_cast<int>(translations.size());
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();

@@ -40,8 +40,8 @@ std::vector<std::string> DescribeMethods(const std::vector<std::string>& names, 
       line += "core RegisterPair, preset C, one 6-DOF search (N_r 30, N 60)";
     } else if (name == "naive") {
       line +=
-          "bo-C's stages, seeds and objective, but Open3D RegistrationICP called afresh per "
-          "evaluation (rebuilds the target kd-tree) and a fresh KDTreeFlann per score";
+          "core RegisterPair with preset C (as bo-C), but every search evaluation calls Open3D "
+          "RegistrationICP afresh (converts the clouds, rebuilds the target kd-tree)";
     } else if (name == "icp-identity") {
       line += "point-to-point ICP from the identity, then the shared coarse-to-fine refinement";
     } else if (name == "pyramid") {

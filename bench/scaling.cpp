@@ -1,8 +1,8 @@
 #include "scaling.hpp"
 
+#include "dataset_config.hpp"
 #include "pair_evaluator.hpp"
 #include "pair_runner.hpp"
-#include "shared_stages.hpp"
 
 namespace boicp::bench {
 

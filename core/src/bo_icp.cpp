@@ -8,6 +8,7 @@
 #include "boicp/icp.hpp"
 #include "boicp/nearest_neighbors.hpp"
 #include "boicp/preprocess.hpp"
+#include "boicp/refinement.hpp"
 #include "boicp/search_space.hpp"
 
 namespace boicp {
@@ -17,21 +18,10 @@ namespace {
 constexpr uint64_t kSubsampleSalt = 0x9e3779b97f4a7c15ULL;
 constexpr uint64_t kStageSalt = 0xbf58476d1ce4e5b9ULL;
 
-Points Prepare(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
-  Points cropped = CropByRange(raw, config.min_range, config.max_range);
-  Points sampled = VoxelDownsample(cropped, voxel);
-  if (sampled.size() < 3) {
-    throw InputError(std::string(which) + " cloud has " + std::to_string(sampled.size()) +
-                     " points after cropping and downsampling (need at least 3)");
-  }
-  return sampled;
-}
-
 // Everything one registration evaluates against, built once per pair.
 struct PairContext {
-  Points search_source;      // voxel-downsampled source
-  Points evaluation_source;  // subsample of it used by every BO evaluation
-  NearestNeighborIndex search_target;
+  const PreparedPair& prepared;
+  Points evaluation_source;  // subsample of prepared.search_source used by every BO evaluation
   IcpOptions search_icp;
 };
 
@@ -74,12 +64,15 @@ class Search {
  private:
   // The paper's objective: the error ICP reaches when started from T0.
   double Evaluate(int stage, const Transform& initial) {
-    const IcpResult icp =
-        AlignPointToPoint(pair_.evaluation_source, pair_.search_target, initial, pair_.search_icp);
-    const AlignmentScore score =
-        ScoreAlignment(pair_.evaluation_source, pair_.search_target, icp.transform,
-                       config_.EffectiveTruncation(), config_.threads);
-    history_.push_back({stage, initial, icp.transform, score.truncated_mean});
+    const NearestNeighborIndex& target = pair_.prepared.search_target;
+    const Transform aligned =
+        callbacks_.local_icp
+            ? callbacks_.local_icp(pair_.evaluation_source, target.points(), initial)
+            : AlignPointToPoint(pair_.evaluation_source, target, initial, pair_.search_icp)
+                  .transform;
+    const AlignmentScore score = ScoreAlignment(pair_.evaluation_source, target, aligned,
+                                                config_.EffectiveTruncation(), config_.threads);
+    history_.push_back({stage, initial, aligned, score.truncated_mean});
     return score.truncated_mean;
   }
 
@@ -99,48 +92,6 @@ Eigen::VectorXd TranslationToUnit(const SearchSpace& space, const Eigen::Vector3
     u[k] = std::clamp(0.5 + offset[p - kX] / (2.0 * space.half_widths[p]), 0.0, 1.0);
   }
   return u;
-}
-
-// Voxel sizes of the refinement pyramid: halving from the search voxel down to
-// the refinement voxel, so every level starts inside the next level's basin.
-std::vector<double> RefinementVoxels(double search_voxel, double refine_voxel) {
-  std::vector<double> voxels;
-  for (double v = search_voxel / 2; v > refine_voxel * 1.01; v /= 2) voxels.push_back(v);
-  voxels.push_back(refine_voxel);
-  return voxels;
-}
-
-// One level of the refinement pyramid, downsampled once per pair.
-struct PyramidLevel {
-  double voxel;
-  Points source;
-  NearestNeighborIndex target;
-};
-
-std::vector<PyramidLevel> BuildPyramid(const Points& raw_source, const Points& raw_target,
-                                       const BoIcpConfig& config) {
-  std::vector<PyramidLevel> levels;
-  for (double voxel : RefinementVoxels(config.voxel, config.EffectiveRefineVoxel())) {
-    levels.push_back({voxel, Prepare(raw_source, config, voxel, "source"),
-                      NearestNeighborIndex(Prepare(raw_target, config, voxel, "target"))});
-  }
-  return levels;
-}
-
-// Coarse-to-fine point-to-point ICP from a search result: all search points
-// first, then each pyramid level with a gate of 3 voxels.
-Transform Refine(const Transform& start, const PairContext& pair,
-                 const std::vector<PyramidLevel>& pyramid, const BoIcpConfig& config) {
-  IcpOptions options = pair.search_icp;
-  options.max_iterations = config.refine_max_iterations;
-  options.max_correspondence_distance = 1.5 * config.voxel;
-  Transform T = AlignPointToPoint(pair.search_source, pair.search_target, start, options).transform;
-  for (const PyramidLevel& level : pyramid) {
-    options.max_correspondence_distance = 3.0 * level.voxel;
-    options.convergence_translation = 1e-3 * level.voxel;
-    T = AlignPointToPoint(level.source, level.target, T, options).transform;
-  }
-  return T;
 }
 
 // The best search results that ended in different places (more than 5 degrees
@@ -168,28 +119,23 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   const auto started = std::chrono::steady_clock::now();
   ValidateConfig(config);
 
-  Points search_source = Prepare(source, config, config.voxel, "source");
-  Points search_target = Prepare(target, config, config.voxel, "target");
-  Points evaluation_source =
-      RandomSubsample(search_source, config.evaluation_points, config.seed ^ kSubsampleSalt);
-  IcpOptions search_icp;
-  search_icp.max_correspondence_distance = config.EffectiveMaxCorrespondence();
-  search_icp.max_iterations = config.icp_max_iterations;
-  search_icp.convergence_translation = 1e-3 * config.voxel;
-  search_icp.threads = config.threads;
-  const PairContext pair{std::move(search_source), std::move(evaluation_source),
-                         NearestNeighborIndex(std::move(search_target)), search_icp};
+  const PreparedPair prepared = PreparePair(source, target, config);
+  const PairContext pair{prepared,
+                         RandomSubsample(prepared.search_source, config.evaluation_points,
+                                         config.seed ^ kSubsampleSalt),
+                         SearchIcpOptions(config)};
+  const Points& search_source = prepared.search_source;
 
   // Without a prior the box is centred on "same orientation, centroids on top
   // of each other"; with one, on the prior itself.
   const Transform anchor = prior.value_or([&] {
     Transform centroids = Transform::Identity();
     centroids.topRightCorner<3, 1>() =
-        Centroid(pair.search_target.points()) - Centroid(pair.search_source);
+        Centroid(prepared.search_target.points()) - Centroid(search_source);
     return centroids;
   }());
   const Point pivot =
-      anchor.topLeftCorner<3, 3>() * Centroid(pair.search_source) + anchor.topRightCorner<3, 1>();
+      anchor.topLeftCorner<3, 3>() * Centroid(search_source) + anchor.topRightCorner<3, 1>();
 
   Search search(pair, config, callbacks);
   RegistrationResult result;
@@ -205,7 +151,7 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
     const Transform rotated = search.Best().result;
     Transform centred = rotated;
     centred.topRightCorner<3, 1>() =
-        pivot - rotated.topLeftCorner<3, 3>() * Centroid(pair.search_source);
+        pivot - rotated.topLeftCorner<3, 3>() * Centroid(search_source);
     const SearchSpace translation =
         MakeSearchSpace(centred, pivot, Eigen::Vector3d::Zero(), config.translation_bounds);
     last = search.RunStage(1, translation, "translation",
@@ -223,20 +169,15 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   // candidates are refined and the one that fits best at the finest level wins.
   const std::vector<Evaluation> candidates =
       DistinctBest(search.history(), config.refine_candidates, config.voxel);
-  const std::vector<PyramidLevel> pyramid = BuildPyramid(source, target, config);
-  const PyramidLevel& finest = pyramid.back();
-  AlignmentScore final_score;
+  RefinedAlignment final_alignment;
   for (size_t k = 0; k < candidates.size(); ++k) {
     if (callbacks.progress) {
       callbacks.progress(
           {"refine", static_cast<int>(k), static_cast<int>(candidates.size()), best.objective});
     }
-    const Transform refined = Refine(candidates[k].result, pair, pyramid, config);
-    const AlignmentScore score = ScoreAlignment(finest.source, finest.target, refined,
-                                                config.EffectiveInlierDistance(), config.threads);
-    if (k == 0 || score.truncated_mean < final_score.truncated_mean) {
-      final_score = score;
-      result.transform = refined;
+    const RefinedAlignment refined = RefineCoarseToFine(candidates[k].result, prepared, config);
+    if (k == 0 || refined.score.truncated_mean < final_alignment.score.truncated_mean) {
+      final_alignment = refined;
     }
   }
   if (callbacks.progress) {
@@ -244,15 +185,16 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
     callbacks.progress({"refine", n, n, best.objective});
   }
 
+  result.transform = final_alignment.transform;
   result.objective = best.objective;
-  result.fitness = final_score.fitness;
-  result.inlier_rmse = final_score.inlier_rmse;
-  result.confidence = final_score.fitness * (1.0 - result.probability_better);
+  result.fitness = final_alignment.score.fitness;
+  result.inlier_rmse = final_alignment.score.inlier_rmse;
+  result.confidence = result.fitness * (1.0 - result.probability_better);
   result.gp_mean = last.gp_mean_at_best;
   result.gp_std = last.gp_std_at_best;
   result.evaluations = static_cast<int>(search.history().size());
-  result.source_points = pair.search_source.size();
-  result.target_points = pair.search_target.size();
+  result.source_points = search_source.size();
+  result.target_points = prepared.search_target.size();
   result.history = std::move(search.history());
   result.runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -4,6 +4,8 @@
 
 #include "boicp/bo_icp.hpp"
 #include "boicp/evaluation.hpp"
+#include "boicp/icp.hpp"
+#include "boicp/refinement.hpp"
 #include "boicp/synthetic_scene.hpp"
 
 namespace boicp {
@@ -72,6 +74,36 @@ TEST(BoIcp, PriorIsTheFirstSample) {
   ASSERT_FALSE(result.history.empty());
   EXPECT_TRUE(result.history.front().initial.isApprox(pair.truth, 1e-12));
   EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
+}
+
+TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
+  const StreetPair pair = MakeStreetPair(0.9);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.iterations = 3;
+  const RegistrationResult plain = RegisterPair(pair.source, pair.target, config);
+
+  // A hook that runs core's own ICP must reproduce the search exactly...
+  int calls = 0;
+  RegistrationCallbacks callbacks;
+  callbacks.local_icp = [&](const Points& source, const Points& target, const Transform& initial) {
+    ++calls;
+    return AlignPointToPoint(source, NearestNeighborIndex(target), initial,
+                             SearchIcpOptions(config))
+        .transform;
+  };
+  const RegistrationResult hooked =
+      RegisterPair(pair.source, pair.target, config, std::nullopt, callbacks);
+  EXPECT_EQ(calls, plain.evaluations);
+  EXPECT_TRUE(hooked.transform == plain.transform);
+  EXPECT_EQ(hooked.objective, plain.objective);
+
+  // ...and one that returns its start unchanged is what the search records.
+  callbacks.local_icp = [](const Points&, const Points&, const Transform& initial) {
+    return initial;
+  };
+  const RegistrationResult identity =
+      RegisterPair(pair.source, pair.target, config, std::nullopt, callbacks);
+  for (const Evaluation& e : identity.history) EXPECT_TRUE(e.result == e.initial);
 }
 
 TEST(BoIcp, StopRequestCancels) {

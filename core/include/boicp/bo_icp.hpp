@@ -52,6 +52,12 @@ struct RegistrationProgress {
 struct RegistrationCallbacks {
   std::function<void(const RegistrationProgress&)> progress;
   std::function<bool()> stop_requested;  // polled between evaluations; true -> boicp::Cancelled
+  /// Replaces the ICP run inside each search evaluation, for baselines that
+  /// measure another ICP implementation against the same search: aligns
+  /// `source` onto `target` from `initial` and returns T_target_source. Empty:
+  /// core's point-to-point ICP against the prebuilt target index.
+  std::function<Transform(const Points& source, const Points& target, const Transform& initial)>
+      local_icp;
 };
 
 /// Registers `source` onto `target` (raw clouds in their sensor frames).

@@ -1,0 +1,23 @@
+#pragma once
+// The BO configuration every method of the bench derives from, so that
+// methods differ only in how they find the initial transform. The shared
+// downsampling and refinement are core's (boicp/refinement.hpp).
+
+#include <string>
+
+#include "boicp/config.hpp"
+#include "methods.hpp"
+
+namespace boicp::bench {
+
+/// N_r and N of every BO run in quick mode.
+constexpr int kQuickBoSamples = 10;
+
+/// Preset `preset` ("A", "B", "C") adapted to the dataset: the preset's N_r
+/// and N (each at most kQuickBoSamples in quick mode), the dataset's bounds,
+/// and a search voxel of dataset.voxel scaled by the preset's voxel relative
+/// to C's (so A and B stay 7/6 coarser, as in the paper); the input's seed and
+/// thread budget.
+BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input);
+
+}  // namespace boicp::bench

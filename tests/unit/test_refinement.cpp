@@ -1,0 +1,58 @@
+// The shared stages around the search: per-pair preparation and the
+// coarse-to-fine refinement every initialiser ends with.
+
+#include <gtest/gtest.h>
+
+#include "boicp/refinement.hpp"
+#include "boicp/synthetic_scene.hpp"
+
+namespace boicp {
+namespace {
+
+BoIcpConfig StreetConfig() {
+  BoIcpConfig config = PresetConfig("C");
+  config.voxel = 0.6;
+  config.refine_voxel = 0.1;
+  return config;
+}
+
+TEST(Refinement, PyramidHalvesFromTheSearchVoxelDownToTheRefineVoxel) {
+  const Points street = MakeSyntheticStreet(5, 20.0);
+  const PreparedPair pair = PreparePair(street, street, StreetConfig());
+  ASSERT_EQ(pair.pyramid.size(), 3u);  // 0.3, 0.15, then the 0.1 refine voxel
+  EXPECT_DOUBLE_EQ(pair.pyramid[0].voxel, 0.3);
+  EXPECT_DOUBLE_EQ(pair.pyramid[1].voxel, 0.15);
+  EXPECT_DOUBLE_EQ(pair.pyramid[2].voxel, 0.1);
+  EXPECT_LT(pair.search_source.size(), pair.pyramid[0].source.size());
+  EXPECT_LT(pair.pyramid[0].source.size(), pair.pyramid[2].source.size());
+}
+
+TEST(Refinement, RecoversATransformFromAStartInsideTheBasin) {
+  const Points world = MakeSyntheticStreet(7, 30.0);
+  const Transform truth = PoseFromYawTranslation(0.05, {0.4, -0.3, 0.0});
+  const Points target = SimulateScan(world, Transform::Identity(), 40.0, 0.0, 1);
+  const Points source = TransformPoints(truth.inverse(), target);
+  const BoIcpConfig config = StreetConfig();
+  const PreparedPair pair = PreparePair(source, target, config);
+
+  const RefinedAlignment refined = RefineCoarseToFine(Transform::Identity(), pair, config);
+  EXPECT_LT(RotationAngle(refined.transform.inverse() * truth), 1e-3);
+  EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
+  EXPECT_GT(refined.score.fitness, 0.99);
+}
+
+TEST(Refinement, CloudEmptiedByCroppingIsAnInputErrorNamingIt) {
+  const Points street = MakeSyntheticStreet(5, 20.0);
+  BoIcpConfig config = StreetConfig();
+  config.max_range = 0.01;
+  try {
+    PrepareCloud(street, config, config.voxel, "target");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("target cloud has 0 points"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace boicp
