@@ -1,19 +1,49 @@
-# Build-and-test image on Debian bookworm, with the same dependency script and
-# build flags as .ci/run. The runtime stage (non-root, volume, HEALTHCHECK)
-# arrives with the daemon and deployment issues.
+# boicp image: boicpd (the gRPC map-building daemon) and boicp (the client).
+#   docker build -t boicp:0.1.0 .
+#   docker run -d --name boicpd -e BOICPD_WORKERS=2 -p 127.0.0.1:50051:50051 \
+#     -v boicpd-data:/var/lib/boicpd boicp:0.1.0
+# The build stage uses the same dependency script and configure flags as
+# .ci/run and runs the tests that need neither ../shared/data nor a daemon;
+# the runtime stage holds only the runtime libraries and the two binaries.
+# tests/deploy/check_deploy.py (ctest deploy_*) keeps this file in step with
+# deploy/install-deps.sh, .ci/run and CMake.
+
 FROM debian:bookworm AS build
 WORKDIR /src
 COPY deploy/install-deps.sh deploy/install-deps.sh
 RUN bash deploy/install-deps.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
+# .ci/run builds with -j2 on the 2-core CI machine; raise it on a bigger builder.
+ARG BUILD_JOBS=2
 RUN cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DBOICP_WARNINGS_AS_ERRORS=ON \
- && cmake --build build -j"$(nproc)" \
- && ctest --test-dir build --output-on-failure -LE realdata
+ && cmake --build build -j"${BUILD_JOBS}"
+RUN ctest --test-dir build --output-on-failure -L "^(unit|style|deploy)$"
 
 FROM debian:bookworm-slim AS runtime
+ARG VERSION=0.1.0
+LABEL org.opencontainers.image.title="boicp" \
+      org.opencontainers.image.description="BO-ICP map building: boicpd daemon, boicp client" \
+      org.opencontainers.image.version="${VERSION}" \
+      org.opencontainers.image.base.name="debian:bookworm-slim" \
+      org.opencontainers.image.licenses="NOASSERTION"
 COPY deploy/install-deps.sh /tmp/install-deps.sh
-RUN bash /tmp/install-deps.sh && rm -rf /var/lib/apt/lists/* /tmp/install-deps.sh
-COPY --from=build /src/build/bin/boicp /usr/local/bin/boicp
-RUN useradd --system --create-home boicp
-USER boicp
-ENTRYPOINT ["boicp"]
+RUN bash /tmp/install-deps.sh --runtime && rm -rf /var/lib/apt/lists/* /tmp/install-deps.sh
+COPY --from=build /src/build/bin/boicpd /src/build/bin/boicp /usr/local/bin/
+# A fixed numeric uid so Kubernetes' runAsNonRoot can check it and volumes can be chowned to it.
+RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/boicpd \
+      --shell /usr/sbin/nologin boicp \
+ && mkdir -p /var/lib/boicpd \
+ && chown boicp:boicp /var/lib/boicpd
+# boicpd reads every flag from BOICPD_<FLAG> as well; the client reads BOICP_SERVER.
+ENV BOICPD_LISTEN=0.0.0.0:50051 \
+    BOICPD_DATA_DIR=/var/lib/boicpd \
+    BOICP_SERVER=127.0.0.1:50051
+VOLUME ["/var/lib/boicpd"]
+EXPOSE 50051
+USER 10001:10001
+WORKDIR /var/lib/boicpd
+# Health and reflection stay open without the bearer token, so the probe needs none.
+HEALTHCHECK --interval=30s --timeout=5s --start-period=30s --retries=3 CMD ["boicp", "health"]
+# boicpd blocks SIGTERM/SIGINT and waits for them, so as PID 1 it still drains on `docker stop`.
+STOPSIGNAL SIGTERM
+CMD ["boicpd"]

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "atomic_file.hpp"
+#include "boicp/atomic_file.hpp"
 #include "machine_info.hpp"
 #include "methods.hpp"
 #include "pair_evaluator.hpp"
@@ -69,7 +69,7 @@ class BenchRun {
     info_.wall_s = Elapsed();
     info_.load_average_end = DescribeMachine().load_average;
     const std::string summary = FormatSummary(info_, rows_);
-    WriteFileAtomically(Path("summary.md"), summary);
+    WriteTextFileAtomically(Path("summary.md"), summary);
     std::cout << "\n"
               << summary << "\nwrote " << Path("results.csv") << " and " << Path("summary.md")
               << std::endl;
@@ -92,7 +92,9 @@ class BenchRun {
     rows_.push_back(std::move(row));
   }
 
-  void WriteResults() const { WriteFileAtomically(Path("results.csv"), FormatResultsCsv(rows_)); }
+  void WriteResults() const {
+    WriteTextFileAtomically(Path("results.csv"), FormatResultsCsv(rows_));
+  }
 
   std::string Path(const std::string& name) const {
     return (std::filesystem::path(options_.out_dir) / name).string();

@@ -15,5 +15,19 @@ using CommandRunner = std::function<int()>;
 
 CommandRunner AddRegisterCommand(CLI::App& app);
 CommandRunner AddDemoDataCommand(CLI::App& app);
+CommandRunner AddMapCommand(CLI::App& app);
+CommandRunner AddPreviewCommand(CLI::App& app);
+CommandRunner AddMergeCommand(CLI::App& app);
+
+#ifdef BOICP_WITH_REMOTE_COMMANDS
+// Talking to the daemon boicpd (built with it).
+CommandRunner AddSubmitCommand(CLI::App& app);
+CommandRunner AddWatchCommand(CLI::App& app);
+CommandRunner AddJobsCommand(CLI::App& app);
+CommandRunner AddShowCommand(CLI::App& app);
+CommandRunner AddCancelCommand(CLI::App& app);
+CommandRunner AddExportCommand(CLI::App& app);
+CommandRunner AddHealthCommand(CLI::App& app);
+#endif
 
 }  // namespace boicp::cli

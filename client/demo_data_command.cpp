@@ -1,6 +1,8 @@
-// `boicp demo-data`: writes a generated pair of scans of a synthetic street,
-// with the true transform, so the demo runs on a machine without real data.
+// `boicp demo-data`: writes a generated pair of scans of a synthetic street
+// with the true transform, or a generated drive with its true poses, so the
+// demo runs on a machine without real data.
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -8,6 +10,7 @@
 
 #include "boicp/point_cloud_io.hpp"
 #include "boicp/synthetic_scene.hpp"
+#include "boicp/trajectory_io.hpp"
 #include "commands.hpp"
 
 namespace boicp::cli {
@@ -17,6 +20,7 @@ struct DemoFlags {
   std::string out = "demo";
   uint64_t seed = 7;
   double yaw_deg = 135.0;
+  int scans = 0;  // 0: the pair; otherwise a drive of this many scans
 };
 
 void WriteTransform(const std::string& path, const Transform& T) {
@@ -28,9 +32,32 @@ void WriteTransform(const std::string& path, const Transform& T) {
   if (!file) throw InputError(path + ": cannot write");
 }
 
+// scan_000.xyz, scan_001.xyz, ... (a folder `boicp map` and `submit` read in
+// name order) and their true poses T_world_scan in truth.kitti.
+void WriteDrive(const DemoFlags& f) {
+  std::vector<Transform> poses;
+  int index = 0;
+  for (const SyntheticScan& scan : MakeSyntheticDrive(f.scans, f.seed)) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "/scan_%03d.xyz", index++);
+    WriteXyz(f.out + name, scan.points);
+    poses.push_back(scan.T_world_scan);
+  }
+  std::ofstream truth(f.out + "/truth.kitti");
+  WriteKittiTrajectory(truth, poses);
+  if (!truth) throw InputError(f.out + "/truth.kitti: cannot write");
+  std::cerr << "wrote " << f.scans << " scans (" << f.out << "/scan_*.xyz) and their true poses ("
+            << f.out << "/truth.kitti)\n";
+}
+
 int RunDemoData(const DemoFlags& f) {
   try {
     std::filesystem::create_directories(f.out);
+    if (f.scans != 0) {
+      if (f.scans < 2) throw InputError("--scans must be 0 (a pair) or at least 2");
+      WriteDrive(f);
+      return kOk;
+    }
     const Points world = MakeSyntheticStreet(f.seed);
     // The source sensor is 1.5 m further along the street and turned by yaw:
     // a pose no plain ICP from identity recovers.
@@ -55,6 +82,9 @@ CommandRunner AddDemoDataCommand(CLI::App& app) {
   app.add_option("-o,--out", flags->out, "Output folder")->capture_default_str();
   app.add_option("--seed", flags->seed, "Scene seed")->capture_default_str();
   app.add_option("--yaw", flags->yaw_deg, "Yaw between the two scans (degrees)")
+      ->capture_default_str();
+  app.add_option("--scans", flags->scans,
+                 "Write a drive of this many scans (scan_*.xyz, truth.kitti) instead of a pair")
       ->capture_default_str();
   return [flags] { return RunDemoData(*flags); };
 }

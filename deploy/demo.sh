@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # The main job on a fresh machine: install dependencies, build everything,
 # start boicpd on a free loopback port with its data directory under build/,
-# submit a demo batch (a generated drive, or the scans of --data DIR), show
-# its progress, write the map and trajectory files, and stop the daemon.
+# submit a logged drive with the boicp client (a generated 8-scan drive, or
+# the scans of --data DIR), follow its progress, export the map, trajectory
+# and preview, and stop the daemon.
 # Usage: bash deploy/demo.sh [--data DIR] [--out OUTDIR] [--preset A|B|C]
-#   --data DIR   a folder of scans (.bin/.pcd/.ply/.xyz, or KITTI's velodyne/)
-#   --out OUTDIR default build/demo: map.bt map.ot map.ply trajectory.tum trajectory.kitti
+#   --data DIR   a scan folder boicp submit reads (KITTI, TUM, 7-Scenes, or .pcd/.ply/.xyz files)
+#   --out OUTDIR default build/demo: map.bt map.png map.ot map.ply trajectory.tum trajectory.kitti
 #   --preset P   BO-ICP preset, default C
 # BOICP_BUILD_DIR (default build) names the build folder.
 set -euo pipefail
@@ -25,9 +26,15 @@ done
 bash deploy/install-deps.sh
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
 cmake --build "$build" -j"$(nproc)"
+boicp="$build/bin/boicp"
+
+mkdir -p "$out"
+if [ -z "$data" ]; then
+  data="$out/drive"
+  "$boicp" demo-data --scans 8 --out "$data"
+fi
 
 data_dir="$build/boicpd-data"
-mkdir -p "$out"
 log="$out/boicpd.log"
 "$build/bin/boicpd" --listen 127.0.0.1:0 --data-dir "$data_dir" --workers "$(nproc)" >"$log" 2>&1 &
 pid=$!
@@ -45,12 +52,16 @@ for _ in $(seq 1 600); do
 done
 if [ -z "$addr" ]; then echo "boicpd did not start:" >&2; cat "$log" >&2; exit 1; fi
 echo "boicpd listening on $addr (log $log, data $data_dir)"
+export BOICP_SERVER="$addr"
 
-args=(--server "$addr" --out "$out" --preset "$preset")
-if [ -n "$data" ]; then args+=(--data "$data"); fi
-"$build/bin/boicp-demo-client" "${args[@]}"
+job="$("$boicp" submit "$data" --config "$preset" --wait)"
+"$boicp" show "$job"
+"$boicp" export "$job" -o "$out/map.bt"  # also writes the preview map.png
+for file in map.ot map.ply trajectory.tum trajectory.kitti; do
+  "$boicp" export "$job" -o "$out/$file" --no-preview
+done
 
 kill -TERM "$pid"
 wait "$pid"
 trap - EXIT
-echo "done: $out/map.bt $out/map.ot $out/map.ply $out/trajectory.tum $out/trajectory.kitti"
+echo "done: $out/{map.bt,map.png,map.ot,map.ply,trajectory.tum,trajectory.kitti}"

@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "boicp/batch_pair.hpp"
 #include "boicp/map_assembly.hpp"
 #include "job_outputs.hpp"
 #include "job_spec.hpp"
@@ -318,9 +319,8 @@ class JobRun {
 
     const bool loops = static_cast<int>(constraints.size()) > num_scans_ - 1;
     SetStage(loops ? "optimising" : "chaining", 0, 1);
-    PoseGraphOptions graph_options;
-    graph_options.max_correspondence_distance = spec_.config.EffectiveInlierDistance();
-    const PoseEstimate estimate = EstimatePoses(spec_.scans, constraints, graph_options);
+    const PoseEstimate estimate =
+        EstimatePoses(spec_.scans, constraints, BatchPoseGraphOptions(spec_.config));
     std::vector<PairIndex> kept;
     for (size_t i = 0; i < used.size(); ++i) {
       if (estimate.kept[i]) kept.push_back(used[i]);

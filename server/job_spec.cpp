@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "boicp/batch_pair.hpp"
 #include "proto_convert.hpp"
 
 namespace boicp::server {
@@ -19,14 +20,6 @@ std::vector<PairIndex> PairsFromProto(const v1::PairingPolicy& pairing) {
     pairs.push_back({static_cast<int>(p.source()), static_cast<int>(p.target())});
   }
   return pairs;
-}
-
-double DefaultThreshold(const std::vector<ScanSource>& scans) {
-  for (const ScanSource& scan : scans) {
-    if (scan.load.format != CloudFormat::kDepthPng)
-      return DefaultOverlapThreshold(scan.load.format);
-  }
-  return DefaultOverlapThreshold(CloudFormat::kDepthPng);
 }
 
 }  // namespace
@@ -124,7 +117,7 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
       if (threshold != 0.0 && !(threshold > 0.0 && threshold <= 1.0)) {
         throw InputError("pairing.overlap_threshold must be in (0, 1] (0 = default)");
       }
-      spec.overlap_threshold = threshold != 0.0 ? threshold : DefaultThreshold(spec.scans);
+      spec.overlap_threshold = threshold != 0.0 ? threshold : BatchOverlapThreshold(spec.scans);
       spec.extra_pairs = listed;
       ValidatePairs(n, listed, /*require_connected=*/false);
       break;

@@ -14,8 +14,8 @@ struct PairOutcome {
   InformationMatrix information;  // for the pose graph, at the refine voxel
 };
 
-/// Loads both scans and runs BO-ICP with the pair's own seed (PairSeed of
-/// the job seed) and the scans' prior poses when both have one. Throws
+/// Core's RegisterBatchPair (the pair's own seed, the scans' prior poses)
+/// wrapped into the API's PairResult. Throws
 /// Cancelled when `stop_requested` fires, InputError when a scan no longer
 /// loads, std::runtime_error for engine failures.
 PairOutcome RegisterJobPair(const JobSpec& spec, const PairIndex& pair,

@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include "sha256.hpp"
+
 namespace boicp::server {
 
 Transform TransformFromProto(const v1::Transform& proto, const std::string& field) {
@@ -86,6 +88,17 @@ LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata) {
     }
   }
   return options;
+}
+
+void ValidateScanMetadata(const v1::ScanMetadata& metadata) {
+  LoadOptionsFromMetadata(metadata);
+  if (metadata.has_sensor_origin()) {
+    PointFromProto(metadata.sensor_origin(), "metadata.sensor_origin");
+  }
+  if (metadata.has_prior_pose()) TransformFromProto(metadata.prior_pose(), "metadata.prior_pose");
+  if (!metadata.sha256().empty() && !IsSha256Hex(metadata.sha256())) {
+    throw InputError("metadata.sha256 must be 64 lowercase hex digits");
+  }
 }
 
 bool IsTerminal(v1::JobState state) {

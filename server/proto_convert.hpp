@@ -28,6 +28,11 @@ CloudFormat FormatFromProto(int format);
 /// when a depth image lacks intrinsics or scale.
 LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata);
 
+/// Every check UploadScan makes on its metadata message before any byte
+/// arrives: format and depth camera, sensor origin, prior pose, and the
+/// optional sha256 (64 lowercase hex digits). Throws InputError naming the field.
+void ValidateScanMetadata(const v1::ScanMetadata& metadata);
+
 bool IsTerminal(v1::JobState state);
 /// "queued", "running", "succeeded", "failed", "cancelled".
 std::string JobStateName(v1::JobState state);

@@ -73,13 +73,7 @@ void UploadReactor::Accept(const v1::UploadScanRequest& request) {
 
 void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
   if (metadata_) throw InputError("metadata may only be sent once, first");
-  LoadOptionsFromMetadata(metadata);  // format and depth camera
-  if (metadata.has_sensor_origin())
-    PointFromProto(metadata.sensor_origin(), "metadata.sensor_origin");
-  if (metadata.has_prior_pose()) TransformFromProto(metadata.prior_pose(), "metadata.prior_pose");
-  if (!metadata.sha256().empty() && !IsSha256Hex(metadata.sha256())) {
-    throw InputError("metadata.sha256 must be 64 lowercase hex digits");
-  }
+  ValidateScanMetadata(metadata);
   known_ = !metadata.sha256().empty() && deps_.store.GetScan(metadata.sha256()) &&
            deps_.data_dir.HasScanFile(metadata.sha256());
   if (!known_) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 
 #include <open3d/geometry/Image.h>
 #include <open3d/io/ImageIO.h>
@@ -52,7 +53,44 @@ void RequireDepthOptions(const std::string& path, const DepthOptions& options) {
   }
 }
 
+uint64_t BigEndianU32(const unsigned char* bytes) {
+  return uint64_t{bytes[0]} << 24 | uint64_t{bytes[1]} << 16 | uint64_t{bytes[2]} << 8 |
+         uint64_t{bytes[3]};
+}
+
+// Open3D allocates the whole image from the PNG header before decoding it, so
+// a 100-byte file declaring 65535 x 65535 pixels costs 8 GB. Deflate expands
+// at most 1032-fold, so a header whose pixels cannot come from the file's
+// bytes is refused here, as is one over kMaxDepthPixels. Anything that is not
+// a PNG header is left to Open3D's own error.
+void RequirePlausiblePngSize(const std::string& path) {
+  constexpr uint64_t kDeflateMaxExpansion = 1032;
+  constexpr uint64_t kMaxDepthPixels = uint64_t{1} << 26;  // 64 Mpx, 8192 x 8192
+  static const unsigned char kSignature[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  std::ifstream in = OpenOrThrow(path, std::ios::in | std::ios::binary);
+  unsigned char head[26] = {};
+  if (!in.read(reinterpret_cast<char*>(head), sizeof(head))) return;
+  if (std::memcmp(head, kSignature, sizeof(kSignature)) != 0) return;
+  if (std::memcmp(head + 12, "IHDR", 4) != 0) return;
+  const uint64_t width = BigEndianU32(head + 16);
+  const uint64_t height = BigEndianU32(head + 20);
+  const uint64_t bit_depth = head[24];
+  const uint64_t channels = head[25] == 2 ? 3 : head[25] == 4 ? 2 : head[25] == 6 ? 4 : 1;
+  std::error_code ec;
+  const uint64_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
+  const std::string size = std::to_string(width) + " x " + std::to_string(height);
+  if (width * height > kMaxDepthPixels) {
+    throw InputError(path + ": depth PNG of " + size + " pixels is over the 64-megapixel limit");
+  }
+  if ((width * height * channels * bit_depth + 7) / 8 > kDeflateMaxExpansion * file_size) {
+    throw InputError(path + ": corrupt PNG (" + size + " pixels cannot fit in " +
+                     std::to_string(file_size) + " bytes)");
+  }
+}
+
 open3d::geometry::Image ReadSixteenBitGrey(const std::string& path) {
+  RequirePlausiblePngSize(path);
   open3d::geometry::Image image;
   bool ok = false;
   try {

@@ -36,6 +36,10 @@ bool IsBlankOrComment(std::string_view line);
 /// InputError "path:LINE: 'token' is not a number".
 std::vector<double> ReadNumbersFile(const std::string& path);
 
+/// Throws InputError unless `path` has a PCD v0.7 header whose declared
+/// sizes fit the file and whose x/y/z Open3D decodes (see io_pcd_header.cpp).
+void RequireSafePcdHeader(const std::string& path);
+
 Points ReadKittiBin(const std::string& path);
 /// PCD or PLY through Open3D; `format` must be kPcd or kPly.
 Points ReadPcdOrPly(const std::string& path, CloudFormat format);

@@ -3,7 +3,7 @@
 #include <chrono>
 #include <fstream>
 
-#include "atomic_write.hpp"
+#include "boicp/atomic_file.hpp"
 #include "boicp/trajectory_io.hpp"
 #include "boicp/voxel_cloud.hpp"
 
@@ -31,7 +31,7 @@ Points WithinRange(const Points& points, const Point& origin, double max_range) 
 }
 
 void WriteText(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  detail::WriteFileAtomically(path, [&](const std::string& tmp) {
+  WriteFileAtomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::trunc);
     write(out);
     if (!out.flush()) throw std::runtime_error(tmp + ": write failed");
@@ -107,12 +107,10 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   summary.occupied_leaves = map.OccupiedLeaves();
   // The .ot keeps full probabilities, so it goes before the .bt conversion.
   if (!outputs.octomap_ot.empty()) {
-    detail::WriteFileAtomically(outputs.octomap_ot,
-                                [&](const std::string& tmp) { map.WriteFull(tmp); });
+    WriteFileAtomically(outputs.octomap_ot, [&](const std::string& tmp) { map.WriteFull(tmp); });
   }
   if (!outputs.octomap_bt.empty()) {
-    detail::WriteFileAtomically(outputs.octomap_bt,
-                                [&](const std::string& tmp) { map.WriteBinary(tmp); });
+    WriteFileAtomically(outputs.octomap_bt, [&](const std::string& tmp) { map.WriteBinary(tmp); });
   }
   if (!outputs.trajectory_tum.empty()) {
     WriteText(outputs.trajectory_tum,
@@ -125,8 +123,8 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   if (want_cloud) {
     const Points merged = cloud.Centroids();
     summary.cloud_points = merged.size();
-    detail::WriteFileAtomically(outputs.cloud_ply,
-                                [&](const std::string& tmp) { WritePlyPoints(tmp, merged); });
+    WriteFileAtomically(outputs.cloud_ply,
+                        [&](const std::string& tmp) { WritePlyPoints(tmp, merged); });
   }
   Report(callbacks, "writing", 1, 1);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -90,4 +90,18 @@ Transform PoseFromYawTranslation(double yaw, const Eigen::Vector3d& translation)
   return T;
 }
 
+std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed) {
+  const Points world = MakeSyntheticStreet(seed);
+  std::vector<SyntheticScan> scans;
+  for (int i = 0; i < num_scans; ++i) {
+    SyntheticScan scan;
+    scan.T_world_scan =
+        PoseFromYawTranslation(0.04 * i, {-7.0 + 2.0 * i, 0.4 * std::sin(0.7 * i), 1.8});
+    scan.points =
+        SimulateScan(world, scan.T_world_scan, 35.0, 0.02, seed + 100 + static_cast<uint64_t>(i));
+    scans.push_back(std::move(scan));
+  }
+  return scans;
+}
+
 }  // namespace boicp

@@ -1,6 +1,5 @@
 #include "demo_sequence.hpp"
 
-#include <cmath>
 #include <cstring>
 
 #include "boicp/synthetic_scene.hpp"
@@ -27,15 +26,9 @@ std::string EncodeKittiBin(const Points& points) {
 }
 
 std::vector<GeneratedScan> MakeDemoSequence(int num_scans, uint64_t seed) {
-  const Points world = MakeSyntheticStreet(seed);
   std::vector<GeneratedScan> scans;
-  for (int i = 0; i < num_scans; ++i) {
-    GeneratedScan scan;
-    const double yaw = 0.04 * i;
-    scan.T_world_scan = PoseFromYawTranslation(yaw, {-7.0 + 2.0 * i, 0.4 * std::sin(0.7 * i), 1.8});
-    scan.kitti_bytes = EncodeKittiBin(
-        SimulateScan(world, scan.T_world_scan, 35.0, 0.02, seed + 100 + static_cast<uint64_t>(i)));
-    scans.push_back(std::move(scan));
+  for (const SyntheticScan& scan : MakeSyntheticDrive(num_scans, seed)) {
+    scans.push_back({EncodeKittiBin(scan.points), scan.T_world_scan});
   }
   return scans;
 }

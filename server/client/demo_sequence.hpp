@@ -16,9 +16,7 @@ struct GeneratedScan {
   Transform T_world_scan = Transform::Identity();
 };
 
-/// `num_scans` scans, 2 m apart along the street with a gentle weave and
-/// turn, seen by a 35 m-range sensor 1.8 m above the ground. Reproducible
-/// for a given seed.
+/// MakeSyntheticDrive's scans, encoded as KITTI .bin files.
 std::vector<GeneratedScan> MakeDemoSequence(int num_scans, uint64_t seed);
 
 /// Encodes points as a KITTI .bin (reflectance 0).

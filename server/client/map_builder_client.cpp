@@ -25,7 +25,8 @@ void Check(const char* rpc, const grpc::Status& status) {
 RpcError::RpcError(const std::string& rpc, const grpc::Status& status)
     : std::runtime_error(rpc + ": " + status.error_message() + " (status " +
                          std::to_string(static_cast<int>(status.error_code())) + ")"),
-      code_(status.error_code()) {}
+      code_(status.error_code()),
+      detail_(status.error_message()) {}
 
 std::shared_ptr<grpc::Channel> Connect(const ConnectOptions& options) {
   grpc::ChannelArguments arguments;
@@ -47,6 +48,13 @@ void MapBuilderClient::Authorize(grpc::ClientContext& context) const {
   if (!token_.empty()) context.AddMetadata("authorization", "Bearer " + token_);
 }
 
+void MapBuilderClient::PrepareUnary(grpc::ClientContext& context) const {
+  Authorize(context);
+  if (unary_timeout_.count() > 0) {
+    context.set_deadline(std::chrono::system_clock::now() + unary_timeout_);
+  }
+}
+
 v1::UploadScanResponse MapBuilderClient::Upload(const std::string& bytes, v1::ScanMetadata metadata,
                                                 size_t chunk_bytes) {
   const std::string id = ScanId(bytes);
@@ -56,7 +64,7 @@ v1::UploadScanResponse MapBuilderClient::Upload(const std::string& bytes, v1::Sc
   bool present = false;
   {
     grpc::ClientContext context;
-    Authorize(context);
+    PrepareUnary(context);
     v1::FindScansRequest request;
     request.add_scan_ids(id);
     v1::FindScansResponse response;
@@ -86,7 +94,7 @@ v1::UploadScanResponse MapBuilderClient::UploadFile(const std::string& path,
 
 v1::Job MapBuilderClient::Submit(const v1::SubmitBatchRequest& request) {
   grpc::ClientContext context;
-  Authorize(context);
+  PrepareUnary(context);
   v1::Job job;
   Check("SubmitBatch", stub_->SubmitBatch(&context, request, &job));
   return job;
@@ -94,7 +102,7 @@ v1::Job MapBuilderClient::Submit(const v1::SubmitBatchRequest& request) {
 
 v1::Job MapBuilderClient::GetJob(const std::string& job_id) {
   grpc::ClientContext context;
-  Authorize(context);
+  PrepareUnary(context);
   v1::GetJobRequest request;
   request.set_job_id(job_id);
   v1::Job job;
@@ -104,7 +112,7 @@ v1::Job MapBuilderClient::GetJob(const std::string& job_id) {
 
 v1::Job MapBuilderClient::Cancel(const std::string& job_id) {
   grpc::ClientContext context;
-  Authorize(context);
+  PrepareUnary(context);
   v1::CancelJobRequest request;
   request.set_job_id(job_id);
   v1::Job job;
@@ -112,9 +120,20 @@ v1::Job MapBuilderClient::Cancel(const std::string& job_id) {
   return job;
 }
 
+v1::ListJobsResponse MapBuilderClient::ListJobs(uint32_t page_size, const std::string& page_token) {
+  grpc::ClientContext context;
+  PrepareUnary(context);
+  v1::ListJobsRequest request;
+  request.set_page_size(page_size);
+  request.set_page_token(page_token);
+  v1::ListJobsResponse response;
+  Check("ListJobs", stub_->ListJobs(&context, request, &response));
+  return response;
+}
+
 v1::JobResults MapBuilderClient::Results(const std::string& job_id) {
   grpc::ClientContext context;
-  Authorize(context);
+  PrepareUnary(context);
   v1::GetResultsRequest request;
   request.set_job_id(job_id);
   v1::JobResults results;

@@ -3,6 +3,7 @@
 // the daemon already holds), submit, watch, fetch results and export. Used
 // by the demo client and the daemon's tests.
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -22,9 +23,12 @@ class RpcError : public std::runtime_error {
  public:
   RpcError(const std::string& rpc, const grpc::Status& status);
   grpc::StatusCode code() const { return code_; }
+  /// The status message alone, without the rpc name and code.
+  const std::string& detail() const { return detail_; }
 
  private:
   grpc::StatusCode code_;
+  std::string detail_;
 };
 
 struct ConnectOptions {
@@ -45,6 +49,11 @@ class MapBuilderClient {
   void Authorize(grpc::ClientContext& context) const;
   v1::MapBuilder::Stub& stub() { return *stub_; }
 
+  /// Deadline for each unary call (FindScans, SubmitBatch, GetJob, ListJobs,
+  /// CancelJob, GetResults), so that an unreachable daemon fails in seconds.
+  /// Streams (upload, watch, export) never get one. 0 (the default) = none.
+  void set_unary_timeout(std::chrono::milliseconds timeout) { unary_timeout_ = timeout; }
+
   /// Uploads a scan; when the daemon already holds these bytes only the
   /// metadata is sent. metadata.size_bytes and sha256 are filled in here.
   v1::UploadScanResponse Upload(const std::string& bytes, v1::ScanMetadata metadata,
@@ -55,6 +64,8 @@ class MapBuilderClient {
   v1::Job Submit(const v1::SubmitBatchRequest& request);
   v1::Job GetJob(const std::string& job_id);
   v1::Job Cancel(const std::string& job_id);
+  /// One page of jobs, newest first; page_size 0 = the daemon's default (50).
+  v1::ListJobsResponse ListJobs(uint32_t page_size = 0, const std::string& page_token = "");
   v1::JobResults Results(const std::string& job_id);
 
   /// Follows WatchJob to its end and returns the job of the last event.
@@ -68,8 +79,12 @@ class MapBuilderClient {
                         const std::string& path);
 
  private:
+  /// Authorize, plus the unary deadline when one is set.
+  void PrepareUnary(grpc::ClientContext& context) const;
+
   std::unique_ptr<v1::MapBuilder::Stub> stub_;
   std::string token_;
+  std::chrono::milliseconds unary_timeout_{0};
 };
 
 /// Lowercase hex SHA-256 of `bytes`, the scan id the daemon will assign.

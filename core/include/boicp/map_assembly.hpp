@@ -51,7 +51,8 @@ struct MapBuildSettings {
 };
 
 /// Where to write each output; an empty path skips that output. Every file
-/// is written to "<path>.tmp" and renamed, so a reader never sees half a file.
+/// is written to a staging file beside it and renamed (WriteFileAtomically), so
+/// a reader never sees half a file.
 struct MapOutputPaths {
   std::string octomap_bt, octomap_ot, trajectory_tum, trajectory_kitti, cloud_ply;
 };

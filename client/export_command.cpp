@@ -1,0 +1,118 @@
+// `boicp export JOB --format F -o FILE`: downloads a finished job's map or
+// trajectory, and for an OctoMap also writes a top-down preview PNG.
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+
+#include "boicp/atomic_file.hpp"
+#include "boicp/map_preview.hpp"
+#include "boicp/trajectory_io.hpp"
+#include "commands.hpp"
+#include "remote_options.hpp"
+#include "remote_proto.hpp"
+
+namespace boicp::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ExportFlags {
+  RemoteFlags remote;
+  std::string job_id, format, output;
+  bool preview = true;
+};
+
+struct ExportKind {
+  v1::ExportFormat format;
+  std::string default_name;
+};
+
+const std::map<std::string, ExportKind>& ExportKinds() {
+  static const std::map<std::string, ExportKind> kinds = {
+      {"bt", {v1::EXPORT_FORMAT_OCTOMAP_BT, "map.bt"}},
+      {"ot", {v1::EXPORT_FORMAT_OCTOMAP_OT, "map.ot"}},
+      {"ply", {v1::EXPORT_FORMAT_POINT_CLOUD_PLY, "map.ply"}},
+      {"tum", {v1::EXPORT_FORMAT_TRAJECTORY_TUM, "trajectory.tum"}},
+      {"kitti", {v1::EXPORT_FORMAT_TRAJECTORY_KITTI, "trajectory.kitti"}}};
+  return kinds;
+}
+
+// --format, else the extension of -o; -o defaults to the daemon's file name.
+std::pair<ExportKind, std::string> ResolveFormat(const ExportFlags& f) {
+  std::string name = f.format;
+  if (name.empty() && !f.output.empty()) {
+    name = fs::path(f.output).extension().string();
+    if (!name.empty()) name = name.substr(1);
+    if (name == "txt") name = "kitti";
+  }
+  const auto found = ExportKinds().find(name);
+  if (found == ExportKinds().end()) {
+    const std::string choices = " (use bt, ot, ply, tum or kitti)";
+    if (!f.format.empty()) throw InputError("--format: unknown '" + f.format + "'" + choices);
+    if (f.output.empty()) throw InputError("--format: needed when -o is not given" + choices);
+    throw InputError("--format: not implied by -o '" + f.output + "'" + choices);
+  }
+  return {found->second, f.output.empty() ? found->second.default_name : f.output};
+}
+
+// The job's poses for the preview, through a KITTI trajectory export:
+// unlike GetResults it has no message-size limit however many scans.
+std::vector<Transform> TrajectoryOf(client::MapBuilderClient& client, const std::string& job_id,
+                                    const std::string& tmp_path) {
+  struct RemoveOnExit {
+    std::string path;
+    ~RemoveOnExit() {
+      std::error_code ignored;
+      fs::remove(path, ignored);
+    }
+  } cleanup{tmp_path};
+  client.ExportToFile(job_id, v1::EXPORT_FORMAT_TRAJECTORY_KITTI, tmp_path);
+  return ReadKittiTrajectory(tmp_path);
+}
+
+int RunExport(const ExportFlags& f) {
+  const auto [kind, output] = ResolveFormat(f);
+  Daemon daemon = ConnectToDaemon(f.remote);
+  const v1::Job job = daemon.client->GetJob(f.job_id);
+  if (job.state() != v1::JOB_STATE_SUCCEEDED) {
+    throw std::runtime_error("job " + f.job_id + " is " + JobStateName(job.state()) +
+                             "; only a succeeded job can be exported");
+  }
+  const fs::path parent = fs::path(output).parent_path();
+  if (!parent.empty()) fs::create_directories(parent);
+  uint64_t bytes = 0;
+  WriteFileAtomically(output, [&](const std::string& tmp) {
+    bytes = daemon.client->ExportToFile(f.job_id, kind.format, tmp);
+  });
+  std::fprintf(stderr, "wrote %s (%llu bytes)\n", output.c_str(),
+               static_cast<unsigned long long>(bytes));
+  const bool octomap =
+      kind.format == v1::EXPORT_FORMAT_OCTOMAP_BT || kind.format == v1::EXPORT_FORMAT_OCTOMAP_OT;
+  if (octomap && f.preview) {
+    const std::string png = fs::path(output).replace_extension(".png").string();
+    WriteMapPreview(output, TrajectoryOf(*daemon.client, f.job_id, png + ".poses.tmp"), png);
+    std::fprintf(stderr, "wrote %s (top-down preview)\n", png.c_str());
+  }
+  return kOk;
+}
+
+}  // namespace
+
+CommandRunner AddExportCommand(CLI::App& app) {
+  auto flags = std::make_shared<ExportFlags>();
+  app.add_option("JOB", flags->job_id, "Id of a succeeded job")->required();
+  app.add_option("--format", flags->format,
+                 "bt (OctoMap binary), ot (OctoMap full), ply (merged cloud), tum or kitti "
+                 "(trajectory T_map_scan); default: from the extension of -o");
+  app.add_option(
+      "-o,--output", flags->output,
+      "File to write (atomically: a staging file, then renamed); default: map.bt, map.ot, "
+      "map.ply, trajectory.tum or trajectory.kitti");
+  app.add_flag("!--no-preview", flags->preview,
+               "For bt/ot, skip the top-down preview PNG written next to FILE (FILE with .png)");
+  AddRemoteOptions(app, flags->remote);
+  return [flags] { return RunRemote("export", flags->remote, [&] { return RunExport(*flags); }); };
+}
+
+}  // namespace boicp::cli

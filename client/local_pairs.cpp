@@ -1,0 +1,138 @@
+#include "local_pairs.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "boicp/atomic_file.hpp"
+#include "json_output.hpp"
+
+namespace boicp::cli {
+namespace {
+
+using nlohmann::json;
+
+json ScanSettings(const ScanSource& scan) {
+  json out = {{"path", scan.path}, {"format", CloudFormatName(scan.load.format)}};
+  if (scan.load.format == CloudFormat::kDepthPng) {
+    const DepthOptions& d = scan.load.depth;
+    if (d.intrinsics) {
+      out["intrinsics"] = {d.intrinsics->fx, d.intrinsics->fy, d.intrinsics->cx, d.intrinsics->cy};
+    }
+    out["depth_scale"] = d.depth_scale;
+    out["invalid_values"] = d.invalid_values;
+  }
+  out["prior_pose"] = scan.prior_pose ? TransformToJson(*scan.prior_pose) : json(nullptr);
+  return out;
+}
+
+Transform TransformFromJson(const json& rows) {
+  Transform T;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j)
+      T(i, j) = rows.at(static_cast<size_t>(i)).at(static_cast<size_t>(j)).get<double>();
+  }
+  return T;
+}
+
+}  // namespace
+
+json PairSettings(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                  const BoIcpConfig& config) {
+  json config_json = ConfigToJson(config);
+  config_json.erase("threads");  // results do not depend on it
+  return {{"config", config_json},
+          {"source", ScanSettings(scans.at(static_cast<size_t>(pair.source)))},
+          {"target", ScanSettings(scans.at(static_cast<size_t>(pair.target)))}};
+}
+
+PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                          const BatchPairResult& result, json settings) {
+  const RegistrationResult& r = result.registration;
+  PairRecord record;
+  record.pair = pair;
+  record.source_path = scans.at(static_cast<size_t>(pair.source)).path;
+  record.target_path = scans.at(static_cast<size_t>(pair.target)).path;
+  record.transform = r.transform;
+  record.objective = r.objective;
+  record.fitness = r.fitness;
+  record.inlier_rmse = r.inlier_rmse;
+  record.confidence = r.confidence;
+  record.evaluations = r.evaluations;
+  record.runtime_s = r.runtime_s;
+  record.seed = result.seed;
+  record.information = result.information;
+  record.settings = std::move(settings);
+  return record;
+}
+
+std::string PairFilePath(const std::string& out_dir, const PairIndex& pair) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "%06d-%06d.json", pair.source, pair.target);
+  return (std::filesystem::path(out_dir) / "pairs" / name).string();
+}
+
+json PairRecordToJson(const PairRecord& r) {
+  return {{"source", r.pair.source},
+          {"target", r.pair.target},
+          {"source_path", r.source_path},
+          {"target_path", r.target_path},
+          {"transform", TransformToJson(r.transform)},
+          {"objective", r.objective},
+          {"fitness", r.fitness},
+          {"inlier_rmse", r.inlier_rmse},
+          {"confidence", r.confidence},
+          {"evaluations", r.evaluations},
+          {"runtime_s", r.runtime_s},
+          {"seed", r.seed}};
+}
+
+void WritePairFile(const std::string& out_dir, const PairRecord& record) {
+  std::filesystem::create_directories(std::filesystem::path(out_dir) / "pairs");
+  json out = PairRecordToJson(record);
+  json information = json::array();
+  for (int i = 0; i < 6; ++i) {
+    json row = json::array();
+    for (int j = 0; j < 6; ++j) row.push_back(record.information(i, j));
+    information.push_back(row);
+  }
+  out["information"] = information;
+  out["settings"] = record.settings;
+  WriteTextFileAtomically(PairFilePath(out_dir, record.pair), out.dump(1) + "\n");
+}
+
+std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairIndex& pair) {
+  const std::string path = PairFilePath(out_dir, pair);
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  try {
+    const json j = json::parse(in);
+    PairRecord r;
+    r.pair = {j.at("source").get<int>(), j.at("target").get<int>()};
+    if (!(r.pair == pair))
+      throw InputError("holds pair " + std::to_string(r.pair.source) + "->" +
+                       std::to_string(r.pair.target));
+    r.source_path = j.at("source_path").get<std::string>();
+    r.target_path = j.at("target_path").get<std::string>();
+    r.transform = TransformFromJson(j.at("transform"));
+    r.objective = j.at("objective").get<double>();
+    r.fitness = j.at("fitness").get<double>();
+    r.inlier_rmse = j.at("inlier_rmse").get<double>();
+    r.confidence = j.at("confidence").get<double>();
+    r.evaluations = j.at("evaluations").get<int>();
+    r.runtime_s = j.at("runtime_s").get<double>();
+    r.seed = j.at("seed").get<uint64_t>();
+    for (int i = 0; i < 6; ++i) {
+      for (int k = 0; k < 6; ++k) {
+        r.information(i, k) =
+            j.at("information").at(static_cast<size_t>(i)).at(static_cast<size_t>(k)).get<double>();
+      }
+    }
+    r.settings = j.at("settings");
+    return r;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": not a pair result file (" + e.what() + ")");
+  }
+}
+
+}  // namespace boicp::cli

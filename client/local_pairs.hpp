@@ -1,0 +1,52 @@
+#pragma once
+// Per-pair result files of a local map run: OUTDIR/pairs/SSSSSS-TTTTTT.json,
+// written atomically as each pair finishes. A rerun, a shard or `boicp
+// merge` reuses a file only when its settings match the run's exactly.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "boicp/batch_pair.hpp"
+
+namespace boicp::cli {
+
+/// One registered pair as stored on disk and listed in pairs.json.
+struct PairRecord {
+  PairIndex pair;
+  std::string source_path, target_path;
+  Transform transform = Transform::Identity();  // T_target_source
+  double objective = 0.0, fitness = 0.0, inlier_rmse = 0.0, confidence = 0.0;
+  int evaluations = 0;
+  double runtime_s = 0.0;
+  uint64_t seed = 0;  // the pair's own seed
+  InformationMatrix information = InformationMatrix::Identity();
+  nlohmann::json settings;  // what the result depends on (PairSettings)
+};
+
+/// Everything a pair's result depends on: the job config (seed included,
+/// thread count excluded) and each scan's path, load options and prior.
+nlohmann::json PairSettings(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                            const BoIcpConfig& config);
+
+PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                          const BatchPairResult& result, nlohmann::json settings);
+
+/// "OUTDIR/pairs/000003-000004.json".
+std::string PairFilePath(const std::string& out_dir, const PairIndex& pair);
+
+/// Writes the record to its file atomically (creating OUTDIR/pairs).
+void WritePairFile(const std::string& out_dir, const PairRecord& record);
+
+/// The stored record, or nullopt when there is no file. Throws InputError
+/// naming the file when it exists but does not parse.
+std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairIndex& pair);
+
+/// The JSON of pairs.json entries: source, target, source_path,
+/// target_path, transform (4x4 row-major), objective, fitness, inlier_rmse,
+/// confidence, evaluations, runtime_s, seed.
+nlohmann::json PairRecordToJson(const PairRecord& record);
+
+}  // namespace boicp::cli

@@ -1,0 +1,382 @@
+#include "local_pipeline.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "boicp/atomic_file.hpp"
+#include "boicp/map_preview.hpp"
+#include "cli_parsing.hpp"
+
+namespace boicp::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+double NowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string FormatDuration(double seconds) {
+  const long s = std::lround(std::max(seconds, 0.0));
+  char text[32];
+  if (s >= 3600) {
+    std::snprintf(text, sizeof(text), "%ldh%02ldm", s / 3600, (s / 60) % 60);
+  } else if (s >= 60) {
+    std::snprintf(text, sizeof(text), "%ldm%02lds", s / 60, s % 60);
+  } else {
+    std::snprintf(text, sizeof(text), "%lds", s);
+  }
+  return text;
+}
+
+std::string PairName(const PairIndex& p) {
+  return std::to_string(p.source) + "->" + std::to_string(p.target);
+}
+
+BoIcpConfig BuildConfig(const MapSettings& s) {
+  BoIcpConfig config = PresetConfig(s.preset);
+  if (s.voxel) config.voxel = *s.voxel;
+  if (s.random_samples) config.random_samples = *s.random_samples;
+  if (s.iterations) config.iterations = *s.iterations;
+  if (!s.rotation_bounds.empty()) {
+    config.rotation_bounds = ParseTriple(s.rotation_bounds, "--rotation-bounds");
+  }
+  if (!s.translation_bounds.empty()) {
+    config.translation_bounds = ParseTriple(s.translation_bounds, "--translation-bounds");
+  }
+  config.seed = s.seed;
+  // Parallelism is across pairs; inside one registration it is one thread,
+  // as the daemon's default --registration-threads.
+  config.threads = 1;
+  ValidateConfig(config);
+  return config;
+}
+
+ScanFolderOptions FolderOptions(const MapSettings& s) {
+  ScanFolderOptions options;
+  options.layout = ParseScanLayout(s.layout);
+  if (!s.intrinsics.empty()) options.intrinsics = ParseIntrinsics(s.intrinsics);
+  options.tum_camera = s.camera;
+  options.depth_scale = s.depth_scale;
+  options.poses_as_priors = s.poses_as_priors;
+  options.first = s.first;
+  options.stride = s.stride;
+  options.count = s.count;
+  return options;
+}
+
+}  // namespace
+
+json MapSettingsToJson(const MapSettings& s) {
+  return {{"path", s.path},
+          {"layout", s.layout},
+          {"config", s.preset},
+          {"pairing", s.pairing},
+          {"pairs_file", s.pairs_file},
+          {"resolution", s.resolution},
+          {"max_range", s.max_range},
+          {"voxel", s.voxel ? json(*s.voxel) : json(nullptr)},
+          {"random_samples", s.random_samples ? json(*s.random_samples) : json(nullptr)},
+          {"iterations", s.iterations ? json(*s.iterations) : json(nullptr)},
+          {"rotation_bounds", s.rotation_bounds},
+          {"translation_bounds", s.translation_bounds},
+          {"seed", s.seed},
+          {"first", s.first},
+          {"stride", s.stride},
+          {"count", s.count},
+          {"intrinsics", s.intrinsics},
+          {"camera", s.camera},
+          {"depth_scale", s.depth_scale},
+          {"poses_as_priors", s.poses_as_priors}};
+}
+
+MapSettings MapSettingsFromJson(const json& j, const std::string& source) {
+  try {
+    MapSettings s;
+    s.path = j.at("path").get<std::string>();
+    s.layout = j.at("layout").get<std::string>();
+    s.preset = j.at("config").get<std::string>();
+    s.pairing = j.at("pairing").get<std::string>();
+    s.pairs_file = j.at("pairs_file").get<std::string>();
+    s.resolution = j.at("resolution").get<double>();
+    s.max_range = j.at("max_range").get<double>();
+    if (!j.at("voxel").is_null()) s.voxel = j.at("voxel").get<double>();
+    if (!j.at("random_samples").is_null()) s.random_samples = j.at("random_samples").get<int>();
+    if (!j.at("iterations").is_null()) s.iterations = j.at("iterations").get<int>();
+    s.rotation_bounds = j.at("rotation_bounds").get<std::string>();
+    s.translation_bounds = j.at("translation_bounds").get<std::string>();
+    s.seed = j.at("seed").get<uint64_t>();
+    s.first = j.at("first").get<int>();
+    s.stride = j.at("stride").get<int>();
+    s.count = j.at("count").get<int>();
+    s.intrinsics = j.at("intrinsics").get<std::string>();
+    s.camera = j.at("camera").get<std::string>();
+    s.depth_scale = j.at("depth_scale").get<double>();
+    s.poses_as_priors = j.at("poses_as_priors").get<bool>();
+    return s;
+  } catch (const json::exception& e) {
+    throw InputError(source + ": bad run settings (" + e.what() + ")");
+  }
+}
+
+std::vector<PairIndex> ReadPairsFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the pairs file");
+  std::vector<PairIndex> pairs;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    if (line.compare(first, 6, "source") == 0) continue;  // a "source,target" header
+    int source = -1, target = -1;
+    char end = 0;
+    if (std::sscanf(line.c_str(), " %d , %d %c", &source, &target, &end) != 2 &&
+        std::sscanf(line.c_str(), " %d %d %c", &source, &target, &end) != 2) {
+      throw InputError(path + ":" + std::to_string(number) + ": expected 'source,target' indices");
+    }
+    pairs.push_back({source, target});
+  }
+  if (pairs.empty()) throw InputError(path + ": lists no pairs");
+  return pairs;
+}
+
+LocalRun PrepareRun(const MapSettings& settings) {
+  LocalRun run;
+  run.settings = settings;
+  run.config = BuildConfig(settings);
+  run.map.occupancy.resolution = settings.resolution;
+  run.map.occupancy.max_range = settings.max_range;
+  try {
+    ValidateOccupancySettings(run.map.occupancy);
+  } catch (const InputError& e) {
+    throw InputError(std::string("map settings: ") + e.what());
+  }
+  run.folder = ReadScanFolder(settings.path, FolderOptions(settings));
+  const int n = static_cast<int>(run.folder.scans.size());
+  if (n < 2) {
+    throw InputError(settings.path + ": a map needs at least 2 scans, the selection has " +
+                     std::to_string(n));
+  }
+  if (settings.pairing == "consecutive") {
+    run.plan = ConsecutivePairs(n);
+  } else if (settings.pairing == "explicit") {
+    if (settings.pairs_file.empty()) throw InputError("--pairing explicit needs a pairs FILE");
+    run.plan = ReadPairsFile(settings.pairs_file);
+    try {
+      ValidatePairs(n, run.plan, /*require_connected=*/true);
+    } catch (const InputError& e) {
+      throw InputError(settings.pairs_file + ": " + e.what());
+    }
+  } else if (settings.pairing == "overlap") {
+    run.keyframes = true;
+    run.overlap_threshold = BatchOverlapThreshold(run.folder.scans);
+  } else {
+    throw InputError("--pairing: '" + settings.pairing +
+                     "' is not consecutive, overlap or explicit");
+  }
+  return run;
+}
+
+PairProgress::PairProgress(int total)
+    : total_(total), started_(NowSeconds()), terminal_(StderrIsTerminal()) {}
+
+void PairProgress::SetTotal(int total) { total_ = total; }
+
+void PairProgress::Done(const PairRecord& record, bool reused) {
+  ++done_;
+  if (!reused) ++registered_;
+  const double elapsed = NowSeconds() - started_;
+  // The rate of pairs registered in this run; reused pairs cost nothing.
+  const std::string eta =
+      registered_ > 0 ? FormatDuration(elapsed / registered_ * std::max(total_ - done_, 0)) : "?";
+  if (terminal_) {
+    constexpr int kWidth = 30;
+    const int filled = total_ > 0 ? kWidth * std::min(done_, total_) / total_ : 0;
+    std::fprintf(stderr, "\r[%s%s] %d/%d pairs  ETA %-8s", std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, '.').c_str(), done_, total_, eta.c_str());
+  } else {
+    std::fprintf(stderr, "pair %s %s (%d/%d): fitness %.3f, %.1f s, ETA %s\n",
+                 PairName(record.pair).c_str(), reused ? "reused" : "done", done_, total_,
+                 record.fitness, record.runtime_s, eta.c_str());
+  }
+  std::fflush(stderr);
+}
+
+void PairProgress::Finish() {
+  if (terminal_ && done_ > 0) std::fputc('\n', stderr);
+  std::fprintf(stderr, "%d pairs (%d registered, %d reused) in %s\n", done_, registered_,
+               done_ - registered_, FormatDuration(NowSeconds() - started_).c_str());
+}
+
+std::map<PairIndex, PairRecord> RunPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
+                                         const std::string& out_dir, int threads,
+                                         PairProgress& progress, int* reused_count) {
+  if (threads < 1) throw InputError("--threads: must be >= 1");
+  const std::vector<ScanSource>& scans = run.folder.scans;
+  std::mutex mutex;
+  size_t next = 0;
+  std::atomic<bool> stop{false};
+  std::exception_ptr failure;
+  std::map<PairIndex, PairRecord> records;
+  int reused_total = 0;
+  auto work = [&] {
+    for (;;) {
+      PairIndex pair;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (next >= pairs.size() || stop) return;
+        pair = pairs[next++];
+      }
+      try {
+        json settings = PairSettings(scans, pair, run.config);
+        std::optional<PairRecord> stored;
+        try {
+          stored = ReadPairFile(out_dir, pair);
+        } catch (const InputError&) {
+          stored.reset();  // unreadable: registered again and overwritten
+        }
+        const bool reused = stored && stored->settings == settings;
+        PairRecord record = reused
+                                ? std::move(*stored)
+                                : MakePairRecord(scans, pair,
+                                                 RegisterBatchPair(scans, pair, run.config,
+                                                                   [&stop] { return stop.load(); }),
+                                                 std::move(settings));
+        if (!reused) WritePairFile(out_dir, record);
+        std::lock_guard<std::mutex> lock(mutex);
+        if (reused) ++reused_total;
+        progress.Done(record, reused);
+        records[pair] = std::move(record);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        stop = true;
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> workers;
+  const int count = std::min<int>(threads, static_cast<int>(pairs.size()));
+  for (int i = 1; i < count; ++i) workers.emplace_back(work);
+  work();
+  for (std::thread& worker : workers) worker.join();
+  if (failure) std::rethrow_exception(failure);
+  if (reused_count) *reused_count += reused_total;
+  return records;
+}
+
+std::map<PairIndex, PairRecord> ReadStoredPairs(const LocalRun& run,
+                                                const std::vector<PairIndex>& pairs,
+                                                const std::vector<std::string>& dirs) {
+  std::map<PairIndex, PairRecord> records;
+  std::string missing;
+  int missing_count = 0;
+  for (const PairIndex& pair : pairs) {
+    for (const std::string& dir : dirs) {
+      std::optional<PairRecord> record = ReadPairFile(dir, pair);
+      if (!record) continue;
+      if (record->settings != PairSettings(run.folder.scans, pair, run.config)) {
+        throw InputError(PairFilePath(dir, pair) + ": computed with other settings than " +
+                         RunManifestPath(dir) + " (rerun that shard)");
+      }
+      records[pair] = std::move(*record);
+      break;
+    }
+    if (records.count(pair) == 0 && ++missing_count <= 10) {
+      missing += (missing.empty() ? "" : ", ") + PairName(pair);
+    }
+  }
+  if (missing_count > 0) {
+    throw InputError(std::to_string(missing_count) + " of " + std::to_string(pairs.size()) +
+                     " pair results missing (" + missing + (missing_count > 10 ? ", ..." : "") +
+                     "); run or rerun the shards that own them");
+  }
+  return records;
+}
+
+std::string RunManifestPath(const std::string& out_dir) {
+  return (fs::path(out_dir) / "run.json").string();
+}
+
+MapSettings ReadRunManifest(const std::string& dir) {
+  const std::string path = RunManifestPath(dir);
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": no such file (not the output folder of boicp map)");
+  json manifest;
+  try {
+    manifest = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(path + ": not JSON (" + e.what() + ")");
+  }
+  return MapSettingsFromJson(manifest, path);
+}
+
+std::string ManifestDifferences(const MapSettings& a, const MapSettings& b) {
+  const json ja = MapSettingsToJson(a), jb = MapSettingsToJson(b);
+  std::string differences;
+  for (const auto& [key, value] : ja.items()) {
+    if (jb.contains(key) && jb[key] == value) continue;
+    differences += (differences.empty() ? "" : ", ") + key + ": " + value.dump() + " vs " +
+                   (jb.contains(key) ? jb[key].dump() : std::string("(none)"));
+  }
+  return differences;
+}
+
+MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairRecord>& chain,
+                                 const std::vector<PairRecord>& all, const std::string& out_dir) {
+  std::vector<PairConstraint> constraints;
+  for (const PairRecord& r : chain) constraints.push_back({r.pair, r.transform, r.information});
+  const PoseEstimate estimate =
+      EstimatePoses(run.folder.scans, constraints, BatchPoseGraphOptions(run.config));
+
+  const fs::path dir(out_dir);
+  fs::create_directories(dir);
+  MapOutputPaths paths;
+  paths.octomap_bt = (dir / "map.bt").string();
+  paths.octomap_ot = (dir / "map.ot").string();
+  paths.trajectory_tum = (dir / "trajectory.tum").string();
+  paths.trajectory_kitti = (dir / "trajectory.kitti").string();
+  AssemblyCallbacks callbacks;
+  const bool terminal = StderrIsTerminal();
+  callbacks.progress = [terminal](const AssemblyProgress& p) {
+    if (p.stage != "fusing") return;
+    if (terminal) {
+      std::fprintf(stderr, "\rfusing %d/%d scans", p.done, p.total);
+      if (p.done == p.total) std::fputc('\n', stderr);
+    } else if (p.done == p.total) {
+      std::fprintf(stderr, "fused %d scans\n", p.total);
+    }
+  };
+  const FusionSummary fusion =
+      FuseScans(run.folder.scans, estimate.poses, run.map, paths, callbacks);
+  WriteMapPreview(paths.octomap_bt, estimate.poses, (dir / "preview.png").string());
+
+  std::set<PairIndex> in_graph;
+  for (size_t i = 0; i < chain.size(); ++i) {
+    if (estimate.kept[i]) in_graph.insert(chain[i].pair);
+  }
+  json listing = json::array();
+  for (const PairRecord& r : all) {
+    json entry = PairRecordToJson(r);
+    entry["in_graph"] = in_graph.count(r.pair) > 0;
+    listing.push_back(std::move(entry));
+  }
+  WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
+
+  MapOutputSummary summary;
+  summary.poses = estimate.poses;
+  summary.optimised = estimate.optimised;
+  summary.occupied_leaves = fusion.occupied_leaves;
+  summary.fusion_s = fusion.seconds;
+  return summary;
+}
+
+}  // namespace boicp::cli

@@ -1,0 +1,123 @@
+#pragma once
+// The one-shot local map pipeline behind `boicp map` and `boicp merge`:
+// the run's settings (as flags and as the run.json manifest), the scan
+// folder, the pairs, running them with per-pair result files, and the
+// outputs. Registration and assembly are core's, the daemon's own code.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "boicp/batch_pair.hpp"
+#include "boicp/scan_folder.hpp"
+#include "local_pairs.hpp"
+
+namespace boicp::cli {
+
+/// Every setting of a map run; what run.json stores.
+struct MapSettings {
+  std::string path;  // scan folder (made absolute)
+  std::string layout = "auto";
+  std::string preset = "C";
+  std::string pairing = "consecutive";  // consecutive | overlap | explicit
+  std::string pairs_file;               // explicit pairing: "source,target" lines
+  double resolution = 0.2;              // OctoMap leaf, metres
+  double max_range = 0.0;               // OctoMap ray cut, metres; 0 = none
+  std::optional<double> voxel;          // search voxel override, metres
+  // N_r and N per search stage; unset = the preset's.
+  std::optional<int> random_samples, iterations;
+  std::string rotation_bounds, translation_bounds;  // "a,b,c" overrides; empty = preset's
+  uint64_t seed = 1;
+  int first = 0, stride = 1, count = 0;
+  std::string intrinsics;  // "fx,fy,cx,cy"
+  std::string camera;      // TUM fr1|fr2|fr3
+  double depth_scale = 0.0;
+  bool poses_as_priors = false;
+};
+
+nlohmann::json MapSettingsToJson(const MapSettings& settings);
+/// Throws InputError naming `source` when a field is missing or mistyped.
+MapSettings MapSettingsFromJson(const nlohmann::json& json, const std::string& source);
+
+/// A run resolved from its settings.
+struct LocalRun {
+  MapSettings settings;
+  ScanFolder folder;
+  BoIcpConfig config;  // config.seed is the job seed; one thread per registration
+  MapBuildSettings map;
+  bool keyframes = false;        // overlap pairing
+  double overlap_threshold = 0;  // keyframes only
+  std::vector<PairIndex> plan;   // consecutive or explicit pairs; empty for keyframes
+};
+
+/// Reads the folder and validates everything (config, map settings,
+/// pairs). Scans are not loaded. Throws InputError naming the field or file.
+LocalRun PrepareRun(const MapSettings& settings);
+
+/// "source,target" index pairs, one a line ('#' comments, blank lines and a
+/// "source,target" header skipped). Throws InputError naming file and line.
+std::vector<PairIndex> ReadPairsFile(const std::string& path);
+
+/// Progress of the registration stage on stderr: a redrawn bar on a
+/// terminal, one line per pair otherwise.
+class PairProgress {
+ public:
+  explicit PairProgress(int total);
+  void SetTotal(int total);
+  /// A pair finished (reused: its file was already there).
+  void Done(const PairRecord& record, bool reused);
+  void Finish();
+
+ private:
+  int total_;
+  int done_ = 0, registered_ = 0;
+  double started_;
+  double registering_s_ = 0.0;
+  bool terminal_;
+};
+
+/// Runs `pairs` on `threads` workers (one registration thread each). A pair
+/// whose file in OUTDIR/pairs holds the same settings is reused, not
+/// redone; every new result is written to its file as soon as it finishes.
+/// Throws the first failure (after the running pairs stop).
+std::map<PairIndex, PairRecord> RunPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
+                                         const std::string& out_dir, int threads,
+                                         PairProgress& progress, int* reused = nullptr);
+
+/// The stored results of `pairs`, each from the first of `dirs` whose
+/// pairs/ holds it, checked against the run's settings. Throws InputError
+/// naming the missing pairs or the first file with other settings.
+std::map<PairIndex, PairRecord> ReadStoredPairs(const LocalRun& run,
+                                                const std::vector<PairIndex>& pairs,
+                                                const std::vector<std::string>& dirs);
+
+/// OUTDIR/run.json, the settings manifest of a run, shard or merge.
+std::string RunManifestPath(const std::string& out_dir);
+
+/// The settings in DIR/run.json. Throws InputError naming the file when it
+/// is missing or malformed.
+MapSettings ReadRunManifest(const std::string& dir);
+
+/// Names the settings that differ between two manifests ("seed: 5 vs 6,
+/// config: A vs C"); empty when they agree.
+std::string ManifestDifferences(const MapSettings& a, const MapSettings& b);
+
+struct MapOutputSummary {
+  std::vector<Transform> poses;  // T_map_scan
+  bool optimised = false;
+  size_t occupied_leaves = 0;
+  double fusion_s = 0.0;
+};
+
+/// From the chain's records (constraint order) to OUTDIR/map.bt, map.ot,
+/// trajectory.tum, trajectory.kitti, pairs.json (every record in `all`,
+/// with in_graph) and preview.png.
+MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairRecord>& chain,
+                                 const std::vector<PairRecord>& all, const std::string& out_dir);
+
+}  // namespace boicp::cli

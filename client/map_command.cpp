@@ -1,0 +1,213 @@
+// `boicp map`: a scan folder to an OctoMap and a trajectory in one process,
+// no daemon, with the daemon's own pair registration and map assembly.
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "boicp/atomic_file.hpp"
+#include "commands.hpp"
+#include "local_pipeline.hpp"
+#include "map_settings_flags.hpp"
+
+namespace boicp::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct MapFlags {
+  MapSettingsFlags map;
+  std::string out_dir;
+  std::string shard;  // "K/N"; empty = the whole run
+  int threads = 1;
+  bool json = false;
+};
+
+std::string Absolute(const std::string& path) {
+  return path.empty() ? path : fs::absolute(path).lexically_normal().string();
+}
+
+// Overlap pairing: each scan onto the current keyframe, decided by the
+// registrations' fitness, in rounds of `threads` probes.
+std::map<PairIndex, PairRecord> RunKeyframes(const LocalRun& run, const std::string& out_dir,
+                                             int threads, PairProgress& progress, int* reused,
+                                             std::vector<PairIndex>* chain) {
+  const int n = static_cast<int>(run.folder.scans.size());
+  KeyframePlanner planner(n, run.overlap_threshold);
+  std::map<PairIndex, PairRecord> all;
+  while (!planner.Done()) {
+    const std::vector<PairIndex> probes = planner.NextProbes(threads);
+    if (probes.empty()) throw std::runtime_error("the keyframe plan stalled");
+    for (auto& [pair, record] : RunPairs(run, probes, out_dir, threads, progress, reused)) {
+      planner.Record(pair, record.fitness);
+      all[pair] = std::move(record);
+    }
+    progress.SetTotal(static_cast<int>(all.size()) + n - planner.AttachedScans());
+  }
+  *chain = planner.ChainPairs();
+  return all;
+}
+
+struct Shard {
+  int index = 0;  // K, 1-based
+  int count = 0;  // N
+};
+
+Shard ParseShard(const std::string& text) {
+  Shard shard;
+  char end = 0;
+  if (std::sscanf(text.c_str(), "%d/%d%c", &shard.index, &shard.count, &end) != 2 ||
+      shard.count < 1 || shard.index < 1 || shard.index > shard.count) {
+    throw InputError("--shard: expected K/N with 1 <= K <= N, got '" + text + "'");
+  }
+  return shard;
+}
+
+// Shards share OUTDIR/run.json: the first writes it, the others must agree.
+void ClaimShardManifest(const LocalRun& run, const std::string& out) {
+  const std::string manifest = RunManifestPath(out);
+  if (fs::exists(manifest)) {
+    const std::string differences = ManifestDifferences(ReadRunManifest(out), run.settings);
+    if (!differences.empty()) {
+      throw InputError(manifest + " holds another run's settings (" + differences +
+                       "); use a fresh OUTDIR");
+    }
+    return;
+  }
+  fs::create_directories(out);
+  WriteTextFileAtomically(manifest, MapSettingsToJson(run.settings).dump(1) + "\n");
+}
+
+// A shard registers the pairs whose index in the plan is K-1 modulo N and
+// writes only their files and the manifest; `boicp merge` builds the map.
+int RunShard(const LocalRun& run, const Shard& shard, const MapFlags& flags) {
+  const std::string& out = flags.out_dir;
+  std::vector<PairIndex> mine;
+  for (size_t i = 0; i < run.plan.size(); ++i) {
+    if (static_cast<int>(i % static_cast<size_t>(shard.count)) == shard.index - 1) {
+      mine.push_back(run.plan[i]);
+    }
+  }
+  std::fprintf(stderr, "shard %d/%d: %zu of %zu pairs\n", shard.index, shard.count, mine.size(),
+               run.plan.size());
+  int reused = 0;
+  PairProgress progress(static_cast<int>(mine.size()));
+  RunPairs(run, mine, out, flags.threads, progress, &reused);
+  progress.Finish();
+  std::fprintf(stderr, "shard %d/%d done; when every shard is, run: boicp merge %s -o OUTDIR\n",
+               shard.index, shard.count, out.c_str());
+  if (flags.json) {
+    std::cout << json{{"shard", flags.shard},
+                      {"pairs", mine.size()},
+                      {"pairs_total", run.plan.size()},
+                      {"pairs_reused", reused},
+                      {"pairs_dir", (fs::path(out) / "pairs").string()}}
+                     .dump()
+              << std::endl;
+  }
+  return kOk;
+}
+
+// The whole run: every pair (reusing finished ones), then the map.
+int BuildMap(const LocalRun& run, const MapFlags& flags,
+             std::chrono::steady_clock::time_point start) {
+  const std::string& out = flags.out_dir;
+  fs::create_directories(out);
+  WriteTextFileAtomically(RunManifestPath(out), MapSettingsToJson(run.settings).dump(1) + "\n");
+
+  int reused = 0;
+  std::vector<PairIndex> chain_pairs = run.plan;
+  std::map<PairIndex, PairRecord> records;
+  PairProgress progress(run.keyframes ? static_cast<int>(run.folder.scans.size()) - 1
+                                      : static_cast<int>(run.plan.size()));
+  if (run.keyframes) {
+    records = RunKeyframes(run, out, flags.threads, progress, &reused, &chain_pairs);
+  } else {
+    records = RunPairs(run, run.plan, out, flags.threads, progress, &reused);
+  }
+  progress.Finish();
+
+  std::vector<PairRecord> chain, all;
+  for (const PairIndex& p : chain_pairs) chain.push_back(records.at(p));
+  if (run.keyframes) {
+    for (const auto& entry : records) all.push_back(entry.second);
+  } else {
+    all = chain;
+  }
+  const MapOutputSummary summary = WriteMapOutputs(run, chain, all, out);
+  std::fprintf(stderr,
+               "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
+               "preview.png}: %zu occupied leaves\n",
+               out.c_str(), summary.occupied_leaves);
+  if (flags.json) {
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    json outputs;
+    for (const char* name :
+         {"map.bt", "map.ot", "trajectory.tum", "trajectory.kitti", "pairs.json", "preview.png"}) {
+      outputs[name] = (fs::path(out) / name).string();
+    }
+    std::cout << json{{"layout", ScanLayoutName(run.folder.layout)},
+                      {"scans", run.folder.scans.size()},
+                      {"pairs", records.size()},
+                      {"pairs_reused", reused},
+                      {"pose_graph_optimised", summary.optimised},
+                      {"occupied_leaves", summary.occupied_leaves},
+                      {"runtime_s", seconds},
+                      {"outputs", outputs}}
+                     .dump()
+              << std::endl;
+  }
+  return kOk;
+}
+
+int RunMap(MapFlags flags) {
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    if (flags.out_dir.empty()) throw InputError("-o OUTDIR is required");
+    if (flags.threads < 1) throw InputError("--threads: must be >= 1");
+    MapSettings settings = ResolveMapSettings(flags.map);
+    settings.path = Absolute(settings.path);
+    settings.pairs_file = Absolute(settings.pairs_file);
+    const LocalRun run = PrepareRun(settings);
+    const std::string& out = flags.out_dir;
+    const std::optional<Shard> shard =
+        flags.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(flags.shard));
+    if (shard && run.keyframes) {
+      throw InputError(
+          "--shard: overlap pairing chooses its pairs as results come in; shard "
+          "consecutive or explicit pairing");
+    }
+    if (shard) ClaimShardManifest(run, out);
+    CheckScansLoad(run.folder);
+    std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
+    if (shard) return RunShard(run, *shard, flags);
+    return BuildMap(run, flags, start);
+  } catch (const InputError& e) {
+    std::cerr << "boicp map: error: " << e.what() << std::endl;
+    return kBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "boicp map: error: " << e.what() << std::endl;
+    return kFailure;
+  }
+}
+
+}  // namespace
+
+CommandRunner AddMapCommand(CLI::App& app) {
+  auto flags = std::make_shared<MapFlags>();
+  MapFlags& f = *flags;
+  AddMapSettingsFlags(app, f.map);
+  app.add_option("-o,--out", f.out_dir, "Output folder");
+  app.add_option("--threads", f.threads, "Pairs registered at once (one thread each)")
+      ->capture_default_str();
+  app.add_option("--shard", f.shard,
+                 "K/N: register only pairs K-1 mod N into OUTDIR/pairs, no map (then merge)");
+  app.add_flag("--json", f.json, "Print a JSON summary on stdout");
+  return [flags] { return RunMap(*flags); };
+}
+
+}  // namespace boicp::cli

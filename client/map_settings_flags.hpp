@@ -1,0 +1,29 @@
+#pragma once
+// The flags `boicp map` and `boicp submit` share: the scan folder and how to
+// read it, the BO-ICP preset and its overrides, the pairing and the map
+// settings. One registration, so both commands spell and default them alike.
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "local_pipeline.hpp"
+
+namespace boicp::cli {
+
+/// What the shared flags parse into. `pairing_words` holds every word CLI11
+/// handed to --pairing: MODE, FILE for explicit, and PATH when PATH came last.
+struct MapSettingsFlags {
+  MapSettings settings;
+  std::vector<std::string> pairing_words = {"consecutive"};
+};
+
+/// Registers PATH and the shared flags on `app`.
+void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags);
+
+/// The settings with --pairing's words split into mode, FILE and PATH.
+/// Throws InputError for a stray word or a missing PATH.
+MapSettings ResolveMapSettings(const MapSettingsFlags& flags);
+
+}  // namespace boicp::cli

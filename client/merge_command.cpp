@@ -1,0 +1,91 @@
+// `boicp merge`: the map of a sharded run. Reads the run.json manifest and
+// every per-pair file the shards wrote (one folder or several), refuses
+// missing pairs or other settings, and writes the same outputs as `boicp map`.
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "boicp/atomic_file.hpp"
+#include "commands.hpp"
+#include "local_pipeline.hpp"
+
+namespace boicp::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct MergeFlags {
+  std::vector<std::string> shard_dirs;
+  std::string out_dir;
+  bool json = false;
+};
+
+// The one manifest all shard folders agree on.
+MapSettings AgreedManifest(const std::vector<std::string>& dirs) {
+  const MapSettings first = ReadRunManifest(dirs.front());
+  for (size_t i = 1; i < dirs.size(); ++i) {
+    const std::string differences = ManifestDifferences(first, ReadRunManifest(dirs[i]));
+    if (!differences.empty()) {
+      throw InputError(RunManifestPath(dirs[i]) + " differs from " + RunManifestPath(dirs.front()) +
+                       " (" + differences + ")");
+    }
+  }
+  return first;
+}
+
+int RunMerge(const MergeFlags& flags) {
+  try {
+    const LocalRun run = PrepareRun(AgreedManifest(flags.shard_dirs));
+    if (run.keyframes) {
+      throw InputError(RunManifestPath(flags.shard_dirs.front()) +
+                       ": overlap pairing is not sharded; run boicp map instead");
+    }
+    const std::map<PairIndex, PairRecord> records =
+        ReadStoredPairs(run, run.plan, flags.shard_dirs);
+    CheckScansLoad(run.folder);
+    std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(),
+                 run.folder.description.c_str(), records.size());
+    std::vector<PairRecord> chain;
+    for (const PairIndex& p : run.plan) chain.push_back(records.at(p));
+    fs::create_directories(flags.out_dir);
+    WriteTextFileAtomically(RunManifestPath(flags.out_dir),
+                            MapSettingsToJson(run.settings).dump(1) + "\n");
+    const MapOutputSummary summary = WriteMapOutputs(run, chain, chain, flags.out_dir);
+    std::fprintf(stderr,
+                 "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
+                 "preview.png}: %zu occupied leaves\n",
+                 flags.out_dir.c_str(), summary.occupied_leaves);
+    if (flags.json) {
+      std::cout << json{{"scans", run.folder.scans.size()},
+                        {"pairs", records.size()},
+                        {"pose_graph_optimised", summary.optimised},
+                        {"occupied_leaves", summary.occupied_leaves},
+                        {"out", flags.out_dir}}
+                       .dump()
+                << std::endl;
+    }
+    return kOk;
+  } catch (const InputError& e) {
+    std::cerr << "boicp merge: error: " << e.what() << std::endl;
+    return kBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "boicp merge: error: " << e.what() << std::endl;
+    return kFailure;
+  }
+}
+
+}  // namespace
+
+CommandRunner AddMergeCommand(CLI::App& app) {
+  auto flags = std::make_shared<MergeFlags>();
+  app.add_option("PATH", flags->shard_dirs,
+                 "Output folder(s) of the shards (each with run.json and pairs/)")
+      ->required();
+  app.add_option("-o,--out", flags->out_dir, "Output folder (may be the shards' own)")->required();
+  app.add_flag("--json", flags->json, "Print a JSON summary on stdout");
+  return [flags] { return RunMerge(*flags); };
+}
+
+}  // namespace boicp::cli

@@ -1,0 +1,58 @@
+#include "remote_json.hpp"
+
+#include "json_output.hpp"
+
+namespace boicp::cli {
+
+nlohmann::json JobToJson(const v1::Job& job) {
+  return {{"job_id", job.job_id()},
+          {"label", job.label()},
+          {"state", JobStateName(job.state())},
+          {"stage", job.stage()},
+          {"pairs_done", job.pairs_done()},
+          {"pairs_total", job.pairs_total()},
+          {"num_scans", job.num_scans()},
+          {"stage_done", job.stage_done()},
+          {"stage_total", job.stage_total()},
+          {"eta_seconds", job.eta_seconds()},
+          {"created_at", job.created_at()},
+          {"started_at", job.started_at()},
+          {"finished_at", job.finished_at()},
+          {"error", job.error()},
+          {"cancel_requested", job.cancel_requested()},
+          {"pose_graph_optimised", job.pose_graph_optimised()}};
+}
+
+nlohmann::json PairToJson(const v1::PairResult& pair) {
+  return {{"source", pair.source()},
+          {"target", pair.target()},
+          {"source_scan_id", pair.source_scan_id()},
+          {"target_scan_id", pair.target_scan_id()},
+          {"transform", TransformToJson(TransformFromProto(pair.transform(), "pair.transform"))},
+          {"objective", pair.objective()},
+          {"fitness", pair.fitness()},
+          {"inlier_rmse", pair.inlier_rmse()},
+          {"confidence", pair.confidence()},
+          {"evaluations", pair.evaluations()},
+          {"runtime_s", pair.runtime_s()},
+          {"finished_at", pair.finished_at()},
+          {"seed", pair.seed()},
+          {"in_graph", pair.in_graph()}};
+}
+
+nlohmann::json ResultsToJson(const v1::JobResults& results) {
+  nlohmann::json json = JobToJson(results.job());
+  json["pairs"] = nlohmann::json::array();
+  for (const v1::PairResult& pair : results.pairs()) json["pairs"].push_back(PairToJson(pair));
+  json["trajectory"] = nlohmann::json::array();
+  for (const v1::TrajectoryPose& pose : results.trajectory()) {
+    json["trajectory"].push_back(
+        {{"index", pose.index()},
+         {"scan_id", pose.scan_id()},
+         {"timestamp", pose.timestamp()},
+         {"pose", TransformToJson(TransformFromProto(pose.pose(), "trajectory.pose"))}});
+  }
+  return json;
+}
+
+}  // namespace boicp::cli

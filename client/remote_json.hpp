@@ -1,0 +1,28 @@
+#pragma once
+// JSON renderings of the daemon's jobs and results, for `jobs --json` and
+// `show --json`. Field names follow the proto (snake_case); states are
+// lowercase words; transforms are 4x4 row-major nested arrays.
+
+#include <nlohmann/json.hpp>
+
+#include "remote_proto.hpp"
+
+namespace boicp::cli {
+
+/// {"job_id", "label", "state", "stage", "pairs_done", "pairs_total",
+///  "num_scans", "stage_done", "stage_total", "eta_seconds", "created_at",
+///  "started_at", "finished_at", "error", "cancel_requested",
+///  "pose_graph_optimised"}; times are Unix seconds (0 = not yet).
+nlohmann::json JobToJson(const v1::Job& job);
+
+/// {"source", "target", "source_scan_id", "target_scan_id", "transform"
+///  (T_target_source), "objective", "fitness", "inlier_rmse", "confidence",
+///  "evaluations", "runtime_s", "finished_at", "seed", "in_graph"}.
+nlohmann::json PairToJson(const v1::PairResult& pair);
+
+/// The job's fields plus "pairs" (in plan order) and "trajectory"
+/// ([{"index", "scan_id", "timestamp", "pose" (T_map_scan)}], empty until
+/// the job succeeded).
+nlohmann::json ResultsToJson(const v1::JobResults& results);
+
+}  // namespace boicp::cli

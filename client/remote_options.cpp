@@ -1,0 +1,113 @@
+#include "remote_options.hpp"
+
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "boicp/types.hpp"
+#include "commands.hpp"
+
+namespace boicp::cli {
+namespace {
+
+std::string ReadFileOrThrow(const std::string& path, const std::string& flag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(flag + " " + path + ": cannot read");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+std::string Trim(const std::string& text) {
+  const char* space = " \t\r\n";
+  const size_t begin = text.find_first_not_of(space);
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(space) - begin + 1);
+}
+
+// gRPC messages may span lines; the error report must stay one line.
+std::string OneLine(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return text;
+}
+
+std::string DescribeRpcError(const client::RpcError& e, const RemoteFlags& flags) {
+  switch (e.code()) {
+    case grpc::StatusCode::UNAVAILABLE:
+      return "cannot reach the daemon at " + flags.server + " (" + e.detail() + ")";
+    case grpc::StatusCode::DEADLINE_EXCEEDED:
+      return "no answer from the daemon at " + flags.server + " within " +
+             std::to_string(kControlTimeout.count()) + " s";
+    case grpc::StatusCode::UNAUTHENTICATED:
+      return flags.token_file.empty()
+                 ? "the daemon at " + flags.server +
+                       " requires a token: pass --token-file FILE (the file given to boicpd "
+                       "--auth-token-file)"
+                 : "the daemon at " + flags.server + " rejected the token in " + flags.token_file +
+                       " (" + e.detail() + ")";
+    case grpc::StatusCode::NOT_FOUND:
+    case grpc::StatusCode::INVALID_ARGUMENT:
+    case grpc::StatusCode::FAILED_PRECONDITION:
+    case grpc::StatusCode::RESOURCE_EXHAUSTED:
+      return e.detail();
+    default:
+      return e.what();
+  }
+}
+
+bool IsBadInput(grpc::StatusCode code) {
+  return code == grpc::StatusCode::INVALID_ARGUMENT || code == grpc::StatusCode::NOT_FOUND ||
+         code == grpc::StatusCode::UNAUTHENTICATED;
+}
+
+}  // namespace
+
+void AddRemoteOptions(CLI::App& app, RemoteFlags& flags) {
+  app.add_option("--server", flags.server, "boicpd address HOST:PORT")
+      ->envname("BOICP_SERVER")
+      ->capture_default_str();
+  app.add_option("--token-file", flags.token_file,
+                 "File holding the bearer token (the daemon's --auth-token-file)");
+  app.add_option("--tls-ca", flags.tls_ca,
+                 "PEM root certificates of a TLS daemon (else plaintext)");
+}
+
+Daemon ConnectToDaemon(const RemoteFlags& flags) {
+  client::ConnectOptions options;
+  options.address = flags.server;
+  options.max_message_bytes = kMaxReceiveBytes;
+  if (!flags.token_file.empty()) {
+    options.token = Trim(ReadFileOrThrow(flags.token_file, "--token-file"));
+    if (options.token.empty()) throw InputError("--token-file " + flags.token_file + ": empty");
+  }
+  if (!flags.tls_ca.empty()) {
+    ReadFileOrThrow(flags.tls_ca, "--tls-ca");  // a clear error before Connect's generic one
+    options.tls_ca_file = flags.tls_ca;
+  }
+  Daemon daemon;
+  daemon.channel = client::Connect(options);
+  daemon.client = std::make_unique<client::MapBuilderClient>(daemon.channel, options.token);
+  daemon.client->set_unary_timeout(kControlTimeout);
+  return daemon;
+}
+
+int RunRemote(const std::string& command, const RemoteFlags& flags,
+              const std::function<int()>& body) {
+  const auto report = [&](const std::string& message, int code) {
+    std::cerr << "boicp " << command << ": error: " << OneLine(message) << std::endl;
+    return code;
+  };
+  try {
+    return body();
+  } catch (const client::RpcError& e) {
+    return report(DescribeRpcError(e, flags), IsBadInput(e.code()) ? kBadInput : kFailure);
+  } catch (const InputError& e) {
+    return report(e.what(), kBadInput);
+  } catch (const std::exception& e) {
+    return report(e.what(), kFailure);
+  }
+}
+
+}  // namespace boicp::cli

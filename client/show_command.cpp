@@ -1,0 +1,71 @@
+// `boicp show JOB`: a job's summary and its per-pair results.
+
+#include <cstdio>
+#include <iostream>
+
+#include "commands.hpp"
+#include "remote_json.hpp"
+#include "remote_options.hpp"
+#include "remote_watch.hpp"
+
+namespace boicp::cli {
+namespace {
+
+struct ShowFlags {
+  RemoteFlags remote;
+  std::string job_id;
+  bool json = false;
+};
+
+void PrintSummary(const v1::JobResults& results) {
+  const v1::Job& job = results.job();
+  std::printf("job         %s\n", job.job_id().c_str());
+  if (!job.label().empty()) std::printf("label       %s\n", job.label().c_str());
+  std::printf("state       %s (stage %s)%s\n", JobStateName(job.state()).c_str(),
+              job.stage().c_str(), job.cancel_requested() ? ", cancel requested" : "");
+  std::printf("scans       %u\n", job.num_scans());
+  std::printf("pairs       %u of %u done%s\n", job.pairs_done(), job.pairs_total(),
+              job.pose_graph_optimised() ? ", pose graph optimised" : "");
+  if (job.started_at() > 0.0) {
+    const double end = job.finished_at() > 0.0 ? job.finished_at() : job.started_at();
+    std::printf("run time    %s%s\n", FormatDuration(end - job.started_at()).c_str(),
+                job.finished_at() > 0.0 ? "" : " so far");
+  }
+  if (!job.error().empty()) std::printf("error       %s\n", job.error().c_str());
+  if (results.pairs_size() == 0) return;
+  // T_target_source summarised by its translation and rotation angle.
+  std::printf("\n%6s %6s %8s %10s %11s %8s %7s %9s %9s %5s\n", "source", "target", "fitness",
+              "confidence", "rmse_m", "objective", "evals", "transl_m", "rot_deg", "time");
+  for (const v1::PairResult& p : results.pairs()) {
+    const Transform T = TransformFromProto(p.transform(), "pair.transform");
+    std::printf("%6u %6u %8.3f %10.3f %11.4f %8.4f %7u %9.3f %9.2f %5s%s\n", p.source(), p.target(),
+                p.fitness(), p.confidence(), p.inlier_rmse(), p.objective(), p.evaluations(),
+                TranslationNorm(T), RotationAngle(T) * 180.0 / M_PI,
+                FormatDuration(p.runtime_s()).c_str(), p.in_graph() ? "" : "  (not in graph)");
+  }
+}
+
+}  // namespace
+
+CommandRunner AddShowCommand(CLI::App& app) {
+  auto flags = std::make_shared<ShowFlags>();
+  app.add_option("JOB", flags->job_id, "Job id")->required();
+  app.add_flag("--json", flags->json,
+               "Print one JSON object: the job's fields, \"pairs\" (T_target_source as 4x4 "
+               "row-major) and \"trajectory\" (T_map_scan)");
+  AddRemoteOptions(app, flags->remote);
+  return [flags] {
+    return RunRemote("show", flags->remote, [&] {
+      Daemon daemon = ConnectToDaemon(flags->remote);
+      const v1::JobResults results = daemon.client->Results(flags->job_id);
+      if (flags->json) {
+        std::cout << ResultsToJson(results).dump() << std::endl;
+      } else {
+        PrintSummary(results);
+      }
+      return kOk;
+    });
+  };
+}
+
+}  // namespace boicp::cli

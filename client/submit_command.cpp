@@ -1,0 +1,152 @@
+// `boicp submit PATH`: reads a folder of scans, checks that every scan
+// loads, uploads what the daemon lacks, submits one batch and prints its
+// job id alone on stdout (with --wait, then follows it like watch).
+
+#include <chrono>
+#include <cstdio>
+
+#include "cli_parsing.hpp"
+#include "commands.hpp"
+#include "local_pipeline.hpp"
+#include "map_settings_flags.hpp"
+#include "remote_options.hpp"
+#include "remote_proto.hpp"
+#include "remote_watch.hpp"
+
+namespace boicp::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct SubmitFlags {
+  RemoteFlags remote;
+  MapSettingsFlags map;  // the same settings, flags and validation as `boicp map`
+  std::string label;
+  bool wait = false;
+};
+
+void SetVector(const Eigen::Vector3d& v, v1::Vector3* out) {
+  out->set_x(v.x());
+  out->set_y(v.y());
+  out->set_z(v.z());
+}
+
+// The batch as PrepareRun validated it; only what the user set overrides
+// the daemon's preset, so both sides apply the same defaults.
+v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
+  const MapSettings& s = run.settings;
+  v1::SubmitBatchRequest request;
+  v1::PairingPolicy& pairing = *request.mutable_pairing();
+  if (run.keyframes) {
+    pairing.set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+    pairing.set_overlap_threshold(run.overlap_threshold);
+  } else {
+    pairing.set_mode(s.pairing == "explicit" ? v1::PairingPolicy::MODE_EXPLICIT
+                                             : v1::PairingPolicy::MODE_CONSECUTIVE);
+    if (s.pairing == "explicit") {
+      for (const PairIndex& p : run.plan) {
+        v1::Pair* pair = pairing.add_pairs();
+        pair->set_source(static_cast<uint32_t>(p.source));
+        pair->set_target(static_cast<uint32_t>(p.target));
+      }
+    }
+  }
+  v1::RegistrationConfig& config = *request.mutable_config();
+  config.set_preset(s.preset);
+  if (s.voxel) config.set_voxel(*s.voxel);
+  if (s.random_samples) config.set_random_samples(*s.random_samples);
+  if (s.iterations) config.set_iterations(*s.iterations);
+  if (!s.rotation_bounds.empty()) {
+    SetVector(run.config.rotation_bounds, config.mutable_rotation_bounds());
+  }
+  if (!s.translation_bounds.empty()) {
+    SetVector(run.config.translation_bounds, config.mutable_translation_bounds());
+  }
+  config.set_seed(s.seed);
+  request.mutable_map()->set_resolution(run.map.occupancy.resolution);
+  request.mutable_map()->set_max_range(run.map.occupancy.max_range);
+  request.set_label(f.label.empty() ? s.path : f.label);
+  return request;
+}
+
+// Uploads every scan (only metadata for bytes the daemon already holds),
+// with progress on stderr; returns the scan ids in order.
+std::vector<std::string> UploadScans(client::MapBuilderClient& client, const ScanFolder& folder,
+                                     const std::vector<v1::ScanMetadata>& metadata) {
+  const bool terminal = StderrIsTerminal();
+  const auto start = Clock::now();
+  auto last_line = start;
+  std::vector<std::string> ids;
+  uint64_t sent_bytes = 0;
+  int already = 0;
+  const size_t n = folder.scans.size();
+  for (size_t i = 0; i < n; ++i) {
+    const v1::UploadScanResponse response = client.UploadFile(folder.scans[i].path, metadata[i]);
+    ids.push_back(response.scan_id());
+    if (response.already_present()) {
+      ++already;
+    } else {
+      sent_bytes += response.size_bytes();
+    }
+    const bool due = Clock::now() - last_line > std::chrono::seconds(5);
+    if (terminal || due) {
+      std::fprintf(stderr,
+                   terminal ? "\ruploading %zu/%zu: %.1f MB sent, %d already held\033[K"
+                            : "uploading %zu/%zu: %.1f MB sent, %d already held\n",
+                   i + 1, n, sent_bytes / 1e6, already);
+      last_line = Clock::now();
+    }
+  }
+  if (terminal) std::fputc('\n', stderr);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  std::fprintf(stderr, "uploaded %zu scans in %.1f s (%.1f MB sent, %d already on the daemon)\n", n,
+               seconds, sent_bytes / 1e6, already);
+  return ids;
+}
+
+int RunSubmit(SubmitFlags& f) {
+  const LocalRun run = PrepareRun(ResolveMapSettings(f.map));
+  const ScanFolder& folder = run.folder;
+  v1::SubmitBatchRequest request = BuildRequest(f, run);
+  std::vector<v1::ScanMetadata> metadata;
+  for (const ScanSource& scan : folder.scans) metadata.push_back(ScanMetadataOf(scan));
+
+  Daemon daemon = ConnectToDaemon(f.remote);
+  daemon.client->ListJobs(1);  // reachable and the token accepted, before the slow checks
+  const auto check_start = Clock::now();
+  CheckScansLoad(folder);
+  std::fprintf(stderr, "%s: %s; every scan loads (checked in %.1f s)\n", run.settings.path.c_str(),
+               folder.description.c_str(),
+               std::chrono::duration<double>(Clock::now() - check_start).count());
+
+  for (const std::string& id : UploadScans(*daemon.client, folder, metadata)) {
+    request.add_scan_ids(id);
+  }
+  const v1::Job job = daemon.client->Submit(request);
+  std::printf("%s\n", job.job_id().c_str());
+  std::fflush(stdout);
+  std::fprintf(stderr, "submitted job %s: %u scans, %u pairs planned, preset %s, seed %llu\n",
+               job.job_id().c_str(), job.num_scans(), job.pairs_total(),
+               request.config().preset().c_str(),
+               static_cast<unsigned long long>(request.config().seed()));
+  return f.wait ? FollowJob(daemon, job.job_id()) : kOk;
+}
+
+}  // namespace
+
+CommandRunner AddSubmitCommand(CLI::App& app) {
+  auto flags = std::make_shared<SubmitFlags>();
+  SubmitFlags& f = *flags;
+  AddMapSettingsFlags(app, f.map);
+  app.add_option("--label", f.label, "Free text shown by jobs; default: PATH");
+  app.add_flag("--wait", f.wait,
+               "Then follow the job like watch; the exit code is watch's (0 only if it "
+               "succeeded)");
+  AddRemoteOptions(app, f.remote);
+  app.footer(
+      "Every scan is loaded once before anything is uploaded. Scans the daemon already holds "
+      "cost one metadata message. Only the job id goes to stdout.");
+  return [flags] { return RunRemote("submit", flags->remote, [&] { return RunSubmit(*flags); }); };
+}
+
+}  // namespace boicp::cli

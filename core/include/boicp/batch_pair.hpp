@@ -1,0 +1,40 @@
+#pragma once
+// One pair registration of a scan batch, as the daemon's workers and the
+// one-shot `boicp map` command both run it: the pair's own seed, the scans'
+// prior poses, and the information matrix the pose graph weighs it by.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "boicp/bo_icp.hpp"
+#include "boicp/map_assembly.hpp"
+#include "boicp/map_pairs.hpp"
+#include "boicp/pose_graph.hpp"
+
+namespace boicp {
+
+struct BatchPairResult {
+  RegistrationResult registration;  // transform = T_target_source
+  InformationMatrix information;    // from correspondences at the refine voxel
+  uint64_t seed = 0;                // the pair's seed, PairSeed(job seed, pair)
+};
+
+/// Loads scans[pair.source] and scans[pair.target] and runs BO-ICP with
+/// `job_config` but seed PairSeed(job_config.seed, pair), centred on
+/// PairPrior when both scans have a prior pose. Throws Cancelled when
+/// `stop_requested` fires, InputError when a scan does not load (or an
+/// index is out of range), std::runtime_error for engine failures.
+BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                                  const BoIcpConfig& job_config,
+                                  const std::function<bool()>& stop_requested = {});
+
+/// The keyframe overlap threshold of a batch: that of its first non-depth
+/// scan's format (0.7), or 0.6 when every scan is a depth image.
+double BatchOverlapThreshold(const std::vector<ScanSource>& scans);
+
+/// Pose-graph options matching how RegisterBatchPair computed the
+/// information matrices (correspondences within the inlier distance).
+PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config);
+
+}  // namespace boicp

@@ -1,0 +1,61 @@
+#include "boicp/batch_pair.hpp"
+
+#include "boicp/voxel_cloud.hpp"
+
+namespace boicp {
+namespace {
+
+Points Downsample(const Points& points, double voxel) {
+  VoxelAccumulator grid(voxel);
+  grid.Add(points);
+  return grid.Centroids();
+}
+
+const ScanSource& ScanAt(const std::vector<ScanSource>& scans, int index) {
+  if (index < 0 || index >= static_cast<int>(scans.size())) {
+    throw InputError("pair index " + std::to_string(index) + " is outside the batch of " +
+                     std::to_string(scans.size()) + " scans");
+  }
+  return scans[static_cast<size_t>(index)];
+}
+
+}  // namespace
+
+BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                                  const BoIcpConfig& job_config,
+                                  const std::function<bool()>& stop_requested) {
+  const ScanSource& source = ScanAt(scans, pair.source);
+  const ScanSource& target = ScanAt(scans, pair.target);
+  const Points source_points = LoadPointCloud(source.path, source.load).points;
+  const Points target_points = LoadPointCloud(target.path, target.load).points;
+
+  BoIcpConfig config = job_config;
+  config.seed = PairSeed(job_config.seed, pair);
+  RegistrationCallbacks callbacks;
+  callbacks.stop_requested = stop_requested;
+  BatchPairResult out;
+  out.seed = config.seed;
+  out.registration =
+      RegisterPair(source_points, target_points, config, PairPrior(source, target), callbacks);
+  const double voxel = config.EffectiveRefineVoxel();
+  out.information =
+      PairInformation(Downsample(source_points, voxel), Downsample(target_points, voxel),
+                      out.registration.transform, config.EffectiveInlierDistance());
+  return out;
+}
+
+double BatchOverlapThreshold(const std::vector<ScanSource>& scans) {
+  for (const ScanSource& scan : scans) {
+    if (scan.load.format != CloudFormat::kDepthPng)
+      return DefaultOverlapThreshold(scan.load.format);
+  }
+  return DefaultOverlapThreshold(CloudFormat::kDepthPng);
+}
+
+PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config) {
+  PoseGraphOptions options;
+  options.max_correspondence_distance = job_config.EffectiveInlierDistance();
+  return options;
+}
+
+}  // namespace boicp

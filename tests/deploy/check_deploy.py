@@ -1,0 +1,467 @@
+#!/usr/bin/env python3
+"""Keeps the deployment files in step with the build, without Docker or a cluster.
+
+Usage: check_deploy.py CHECK --root SRC --build-dir BUILD --boicpd PATH --boicp PATH
+CHECK is one of: dockerfile, runtime-packages, manifests, readme-table.
+Prints one line per problem and exits 1 when there is any; 77 (ctest's skip
+code here) when a tool the check needs is missing.
+"""
+
+import argparse
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+
+SKIP = 77
+
+
+# ---------------------------------------------------------------- helpers
+
+
+def read(path):
+    with open(path, encoding="utf-8") as f:
+        return f.read()
+
+
+def run(args):
+    return subprocess.run(args, check=True, capture_output=True, text=True).stdout
+
+
+def package_lists(root):
+    script = os.path.join(root, "deploy", "install-deps.sh")
+    build = run(["bash", script, "--list"]).split()
+    runtime = run(["bash", script, "--list-runtime"]).split()
+    return build, runtime
+
+
+def daemon_env_options(boicpd):
+    """{flag: (env, default or None)} from `boicpd --help`, the code's own view."""
+    pattern = re.compile(r"^\s+(--[a-z-]+) [A-Z]+(?:=(\S+))?(?: REQUIRED)? \(Env:(\w+)\)")
+    options = {}
+    for line in run([boicpd, "--help"]).splitlines():
+        m = pattern.match(line)
+        if m:
+            options[m.group(1)] = (m.group(3), m.group(2))
+    return options
+
+
+def project_version(root):
+    m = re.search(r"project\(boicp VERSION (\S+)", read(os.path.join(root, "CMakeLists.txt")))
+    return m.group(1)
+
+
+# ---------------------------------------------------------- Dockerfile parse
+
+
+def dockerfile_instructions(text):
+    """[(stage_index, INSTRUCTION, argument)] with continuations joined."""
+    logical, current = [], ""
+    for line in text.splitlines():
+        if not current and (not line.strip() or line.lstrip().startswith("#")):
+            continue
+        if line.rstrip().endswith("\\"):
+            current += line.rstrip()[:-1] + " "
+            continue
+        logical.append(current + line)
+        current = ""
+    result, stage = [], -1
+    for line in logical:
+        keyword, _, argument = line.strip().partition(" ")
+        keyword = keyword.upper()
+        if keyword == "FROM":
+            stage += 1
+        result.append((stage, keyword, argument.strip()))
+    return result
+
+
+def shell_commands(argument):
+    """The simple commands of a RUN line: its words, split at && || ; and |."""
+    lexer = shlex.shlex(argument, posix=True, punctuation_chars=True)
+    lexer.whitespace_split = True
+    commands, words = [], []
+    for token in lexer:
+        if token in ("&&", "||", ";", "|", "&"):
+            commands.append(words)
+            words = []
+        else:
+            words.append(token)
+    return [c for c in commands + [words] if c]
+
+
+def configure_flags(commands):
+    """The -D/-G options of the `cmake -S ... -B build` command (the main build tree;
+    .ci/run may configure other trees, e.g. for sanitizers, after it)."""
+    for words in commands:
+        if words[:1] == ["cmake"] and "-S" in words and "-B" in words:
+            if words[words.index("-B") + 1] == "build":
+                return sorted(w for w in words if w.startswith(("-D", "-G")))
+    return None
+
+
+def exec_form(argument):
+    m = re.search(r"\[.*\]", argument)
+    return [w.strip().strip('"') for w in m.group(0)[1:-1].split(",")] if m else shlex.split(argument)
+
+
+# ------------------------------------------------------------------ checks
+
+
+def check_dockerfile(args):
+    problems = []
+    root = args.root
+    instructions = dockerfile_instructions(read(os.path.join(root, "Dockerfile")))
+    build_packages, runtime_packages = package_lists(root)
+    env_options = daemon_env_options(args.boicpd)
+    known_env = {env for env, _ in env_options.values()}
+
+    stages = [a for _, k, a in instructions if k == "FROM"]
+    if len(stages) != 2 or not all(s.split()[0].startswith("debian:bookworm") for s in stages):
+        problems.append(f"Dockerfile: want two stages FROM debian:bookworm*, got {stages}")
+
+    runs = [(stage, a) for stage, k, a in instructions if k == "RUN"]
+    problems += check_apt_and_deps_script(runs, build_packages, runtime_packages)
+    problems += check_build_flags(root, runs)
+    problems += check_test_labels(runs)
+    problems += check_copied_binaries(args, instructions)
+    problems += check_runtime_stage(instructions, known_env, root)
+    return problems
+
+
+def check_apt_and_deps_script(runs, build_packages, runtime_packages):
+    problems, used_deps_script = [], {}
+    allowed = set(build_packages) | set(runtime_packages)
+    for stage, argument in runs:
+        for words in shell_commands(argument):
+            runs_script = words[0] in ("bash", "sh") and words[1:2] or words[:1]
+            if runs_script and runs_script[0].endswith("install-deps.sh"):
+                used_deps_script[stage] = [w for w in words if w.startswith("--")]
+            if len(words) > 2 and words[0] in ("apt-get", "apt") and "install" in words:
+                extra = [w for w in words[words.index("install") + 1 :] if not w.startswith("-")]
+                problems += [
+                    f"Dockerfile: apt package {p} is not in install-deps.sh --list or --list-runtime"
+                    for p in extra
+                    if p not in allowed
+                ]
+    if used_deps_script.get(0) != []:
+        problems.append("Dockerfile: the build stage must run deploy/install-deps.sh with no flags")
+    if used_deps_script.get(1) != ["--runtime"]:
+        problems.append("Dockerfile: the runtime stage must run deploy/install-deps.sh --runtime")
+    return problems
+
+
+def check_build_flags(root, runs):
+    ci = read(os.path.join(root, ".ci", "run"))
+    lines = ci.replace("\\\n", " ").splitlines()
+    ci_commands = [c for line in lines if not line.startswith("#") for c in shell_commands(line)]
+    ci_flags = configure_flags(ci_commands)
+    docker_flags = None
+    for _, argument in runs:
+        docker_flags = docker_flags or configure_flags(shell_commands(argument))
+    if ci_flags is None:
+        return [".ci/run: no `cmake -S` configure line found"]
+    if docker_flags != ci_flags:
+        return [f"Dockerfile: configure flags {docker_flags} differ from .ci/run's {ci_flags}"]
+    return []
+
+
+def check_test_labels(runs):
+    """The image build runs ctest on labels that need no shared data and no daemon."""
+    for _, argument in runs:
+        for words in shell_commands(argument):
+            if words[:1] == ["ctest"]:
+                if "-L" not in words:
+                    return ["Dockerfile: ctest must select labels with -L (no realdata/server)"]
+                regex = words[words.index("-L") + 1]
+                wrong = [l for l in ("realdata", "server") if re.search(regex, l)]
+                if wrong or not re.search(regex, "unit"):
+                    return [f"Dockerfile: ctest -L {regex!r} must match unit, not {wrong}"]
+                return []
+    return ["Dockerfile: the build stage runs no ctest"]
+
+
+def check_copied_binaries(args, instructions):
+    built = {}
+    for path in (args.boicpd, args.boicp):
+        built[os.path.basename(path)] = os.path.relpath(path, args.build_dir)
+    copied = {}
+    for stage, keyword, argument in instructions:
+        if keyword == "COPY" and "--from=build" in argument:
+            sources = [w for w in argument.split() if not w.startswith("--")][:-1]
+            for source in sources:
+                copied[os.path.basename(source)] = source
+    problems = []
+    if set(copied) != set(built):
+        problems.append(f"Dockerfile: copies {sorted(copied)}, CMake builds {sorted(built)}")
+    for name, source in copied.items():
+        if name in built and not source.endswith("/build/" + built[name]):
+            problems.append(f"Dockerfile: {source} is not where CMake puts {name} (build/{built[name]})")
+    return problems
+
+
+def check_runtime_stage(instructions, known_env, root):
+    runtime = [(k, a) for stage, k, a in instructions if stage == 1]
+    by_keyword = {}
+    for keyword, argument in runtime:
+        by_keyword.setdefault(keyword, []).append(argument)
+    problems = []
+    health = by_keyword.get("HEALTHCHECK", [])
+    if len(health) != 1 or exec_form(health[0].partition("CMD")[2])[:2] != ["boicp", "health"]:
+        problems.append("Dockerfile: the runtime stage needs one HEALTHCHECK CMD boicp health")
+    users = by_keyword.get("USER", [])
+    if not users or users[-1].split(":")[0] in ("root", "0"):
+        problems.append("Dockerfile: the runtime stage must end with a non-root USER")
+    env = dockerfile_env(by_keyword.get("ENV", []))
+    problems += [
+        f"Dockerfile: ENV {name} is not a boicpd variable"
+        for name in env
+        if name.startswith("BOICPD_") and name not in known_env
+    ]
+    volumes = " ".join(by_keyword.get("VOLUME", []))
+    if env.get("BOICPD_DATA_DIR") is None or env["BOICPD_DATA_DIR"] not in volumes:
+        problems.append("Dockerfile: VOLUME must hold ENV BOICPD_DATA_DIR")
+    port = env.get("BOICPD_LISTEN", "").rpartition(":")[2]
+    if not port or port not in " ".join(by_keyword.get("EXPOSE", [])):
+        problems.append("Dockerfile: EXPOSE must give BOICPD_LISTEN's port")
+    if exec_form((by_keyword.get("CMD") or [""])[-1])[:1] != ["boicpd"]:
+        problems.append("Dockerfile: the image's CMD must start boicpd")
+    labels = " ".join(by_keyword.get("LABEL", []))
+    if "org.opencontainers.image.title" not in labels:
+        problems.append("Dockerfile: OCI labels (org.opencontainers.image.*) missing")
+    version = re.search(r"ARG VERSION=(\S+)", read(os.path.join(root, "Dockerfile")))
+    if not version or version.group(1) != project_version(root):
+        problems.append("Dockerfile: ARG VERSION must equal CMake's project VERSION")
+    return problems
+
+
+def dockerfile_env(arguments):
+    env = {}
+    for argument in arguments:
+        for word in shlex.split(argument):
+            name, _, value = word.partition("=")
+            env[name] = value
+    return env
+
+
+def check_runtime_packages(args):
+    """Every library the binaries link directly comes from a --list-runtime package, and
+    every such package is linked, so the runtime image neither misses nor carries one."""
+    if not (shutil.which("objdump") and shutil.which("dpkg-query") and shutil.which("ldd")):
+        print("objdump, ldd or dpkg-query missing: not a Debian build machine")
+        return None
+    _, runtime = package_lists(args.root)
+    libraries, problems = {}, []
+    for binary in (args.boicpd, args.boicp):
+        resolved = dict(re.findall(r"^\s*(\S+) => (\S+)", run(["ldd", binary]), re.M))
+        for library in re.findall(r"^\s*NEEDED\s+(\S+)", run(["objdump", "-p", binary]), re.M):
+            if library in resolved:
+                libraries[library] = resolved[library]
+            else:
+                problems.append(f"{binary}: {library} does not resolve")
+    owners = owning_packages(libraries.values())
+    needed_packages = set()
+    for library, path in sorted(libraries.items()):
+        if path in owners:
+            needed_packages.add(owners[path])
+        else:
+            problems.append(f"no Debian package owns {path} ({library})")
+    problems += [
+        f"install-deps.sh --list-runtime lacks {p} (linked by boicpd/boicp)"
+        for p in sorted(needed_packages - set(runtime))
+    ]
+    problems += [
+        f"install-deps.sh --list-runtime has {p}, which neither binary links"
+        for p in sorted(set(runtime) - needed_packages)
+    ]
+    return problems
+
+
+def owning_packages(paths):
+    """{path: package} from one dpkg-query call. Debian's merged /usr means dpkg may
+    know a library under /lib, /usr/lib, or only by its resolved name."""
+    aliases = {}
+    for path in paths:
+        for candidate in (path, os.path.realpath(path)):
+            aliases[candidate] = path
+            if candidate.startswith("/usr/lib/"):
+                aliases[candidate[len("/usr") :]] = path
+    result = subprocess.run(
+        ["dpkg-query", "-S", *sorted(aliases)], capture_output=True, text=True
+    )  # exits 1 when some alias is unknown; the others are still listed
+    owners = {}
+    for line in result.stdout.splitlines():
+        package, _, candidate = line.partition(": ")
+        if candidate in aliases:
+            owners[aliases[candidate]] = package.split(":")[0].split(",")[0].strip()
+    return owners
+
+
+def load_yaml_documents(paths):
+    import yaml  # python3-yaml, a dependency of yamllint
+
+    documents = []
+    for path in paths:
+        with open(path, encoding="utf-8") as f:
+            documents += [(path, d) for d in yaml.safe_load_all(f) if d]
+    return documents
+
+
+def check_manifests(args):
+    root = args.root
+    k8s = os.path.join(root, "deploy", "k8s")
+    paths = sorted(
+        os.path.join(d, f) for d, _, files in os.walk(k8s) for f in files if f.endswith(".yaml")
+    )
+    docs = load_yaml_documents(paths)
+    known_env = {env for env, _ in daemon_env_options(args.boicpd).values()}
+    image = "boicp:" + project_version(root)
+    uid = re.search(r"--uid (\d+)", read(os.path.join(root, "Dockerfile"))).group(1)
+    problems = []
+    for path, doc in docs:
+        kind = doc.get("kind")
+        name = f"{os.path.relpath(path, root)} ({kind})"
+        if kind == "Kustomization":
+            problems += [
+                f"{name}: resource {r} does not exist"
+                for r in doc.get("resources", [])
+                if not os.path.exists(os.path.join(os.path.dirname(path), r))
+            ]
+            continue
+        pod = pod_spec(doc)
+        if pod is None:
+            continue
+        problems += check_pod(name, pod, image, uid, known_env)
+        if kind == "Job" and doc["spec"].get("completionMode") == "Indexed":
+            problems += check_indexed_job(name, doc)
+        if kind == "Deployment":
+            problems += check_daemon_pod(name, pod["containers"][0])
+    problems += check_compose(root, image, known_env)
+    return problems
+
+
+def pod_spec(doc):
+    return doc.get("spec", {}).get("template", {}).get("spec")
+
+
+def container_env(container):
+    return {e["name"]: e.get("value") for e in container.get("env", [])}
+
+
+def check_pod(name, pod, image, uid, known_env):
+    problems = []
+    if str(pod.get("securityContext", {}).get("runAsUser")) != uid:
+        problems.append(f"{name}: runAsUser must be the image's uid {uid}")
+    for c in pod["containers"]:
+        if c.get("image") != image:
+            problems.append(f"{name}: image {c.get('image')} is not {image}")
+        if "requests" not in c.get("resources", {}):
+            problems.append(f"{name}: container {c['name']} has no resource requests")
+        problems += [
+            f"{name}: env {e} is not a boicpd variable"
+            for e in container_env(c)
+            if e.startswith("BOICPD_") and e not in known_env
+        ]
+    return problems
+
+
+def check_indexed_job(name, doc):
+    container = pod_spec(doc)["containers"][0]
+    script = " ".join(container.get("command", []) + container.get("args", []))
+    problems = []
+    if str(container_env(container).get("BOICP_SHARDS")) != str(doc["spec"].get("completions")):
+        problems.append(f"{name}: BOICP_SHARDS must equal completions")
+    if "JOB_COMPLETION_INDEX + 1" not in script or "--shard" not in script:
+        problems.append(f"{name}: the shard must be --shard $((JOB_COMPLETION_INDEX + 1))/N")
+    return problems
+
+
+def check_daemon_pod(name, container):
+    env = container_env(container)
+    port = env.get("BOICPD_LISTEN", "").rpartition(":")[2]
+    problems = []
+    ports = [str(p["containerPort"]) for p in container.get("ports", [])]
+    if port not in ports:
+        problems.append(f"{name}: containerPort must be BOICPD_LISTEN's port {port}")
+    for probe in ("startupProbe", "readinessProbe", "livenessProbe"):
+        if str(container.get(probe, {}).get("grpc", {}).get("port")) != port:
+            problems.append(f"{name}: {probe} must be a grpc probe on port {port}")
+    cpu = str(container.get("resources", {}).get("requests", {}).get("cpu"))
+    if env.get("BOICPD_WORKERS") != cpu:
+        problems.append(f"{name}: BOICPD_WORKERS must equal the CPU request ({cpu})")
+    return problems
+
+
+def check_compose(root, image, known_env):
+    path = os.path.join(root, "deploy", "docker-compose.yml")
+    services = load_yaml_documents([path])[0][1]["services"]
+    problems = []
+    daemon = services.get("boicpd", {})
+    if daemon.get("healthcheck", {}).get("test", [])[1:3] != ["boicp", "health"]:
+        problems.append("deploy/docker-compose.yml: boicpd's healthcheck must run boicp health")
+    for name, service in services.items():
+        if service.get("image") != image:
+            problems.append(f"deploy/docker-compose.yml: {name} image is not {image}")
+        problems += [
+            f"deploy/docker-compose.yml: {name} env {e} is not a boicpd variable"
+            for e in service.get("environment", {})
+            if e.startswith("BOICPD_") and e not in known_env
+        ]
+    return problems
+
+
+def check_readme_table(args):
+    """README's Deploy table lists exactly boicpd's flags, their variables and defaults."""
+    text = read(os.path.join(args.root, "README.md"))
+    section = text.partition("\n## Deploy\n")[2].partition("\n## ")[0]
+    if not section:
+        return ["README.md: no '## Deploy' section"]
+    rows = {}
+    for line in section.splitlines():
+        m = re.match(r"\|\s*`(--[a-z-]+)`\s*\|\s*`(\w+)`\s*\|([^|]*)\|", line)
+        if m:
+            rows[m.group(1)] = (m.group(2), m.group(3).strip())
+    options = daemon_env_options(args.boicpd)
+    problems = []
+    for flag in sorted(set(options) | set(rows)):
+        if flag not in rows:
+            problems.append(f"README.md Deploy table: {flag} missing")
+        elif flag not in options:
+            problems.append(f"README.md Deploy table: {flag} is not a boicpd flag")
+        elif rows[flag][0] != options[flag][0]:
+            problems.append(f"README.md Deploy table: {flag} reads {options[flag][0]}")
+        else:
+            literal = re.fullmatch(r"`([^`]*)`", rows[flag][1])
+            if literal and options[flag][1] is not None and literal.group(1) != options[flag][1]:
+                problems.append(f"README.md Deploy table: {flag} default is {options[flag][1]}")
+    return problems
+
+
+CHECKS = {
+    "dockerfile": check_dockerfile,
+    "runtime-packages": check_runtime_packages,
+    "manifests": check_manifests,
+    "readme-table": check_readme_table,
+}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("check", choices=sorted(CHECKS))
+    parser.add_argument("--root", required=True)
+    parser.add_argument("--build-dir", required=True)
+    parser.add_argument("--boicpd", required=True)
+    parser.add_argument("--boicp", required=True)
+    args = parser.parse_args()
+    problems = CHECKS[args.check](args)
+    if problems is None:
+        return SKIP
+    for problem in problems:
+        print(problem)
+    print(f"{args.check}: {'ok' if not problems else f'{len(problems)} problem(s)'}")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,151 @@
+// Map previews: rendering (colour by height, colour bar, trajectory marks),
+// PNG output through Open3D, and reading occupied cells from .bt / .ot files.
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <open3d/geometry/Image.h>
+#include <open3d/io/ImageIO.h>
+
+#include "boicp/map_preview.hpp"
+#include "boicp/occupancy_map.hpp"
+
+namespace boicp {
+namespace {
+
+// True when `dir` holds a staging file left by an atomic write.
+bool HasStagingFile(const std::filesystem::path& dir) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() == ".tmp") return true;
+  }
+  return false;
+}
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+std::array<int, 3> PixelAt(const RgbImage& image, int x, int y) {
+  const size_t i =
+      (static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x)) * 3;
+  return {image.pixels[i], image.pixels[i + 1], image.pixels[i + 2]};
+}
+
+// A 10 m x 5 m floor at z = 0 with a 3 m wall along its north edge.
+OccupiedCells FloorAndWall() {
+  OccupiedCells cells;
+  cells.resolution = 0.25;
+  for (double x = 0.125; x < 10; x += 0.25) {
+    for (double y = 0.125; y < 5; y += 0.25) {
+      cells.centres.emplace_back(x, y, 0.0);
+      cells.sizes.push_back(0.25);
+    }
+    for (double z = 0.125; z < 3; z += 0.25) {
+      cells.centres.emplace_back(x, 4.875, z);
+      cells.sizes.push_back(0.25);
+    }
+  }
+  return cells;
+}
+
+TEST(MapPreview, ColoursByHeightWithTrajectoryMarks) {
+  PreviewOptions options;
+  options.size_px = 400;
+  const Points trajectory = {{1, 1, 0}, {5, 2, 0}, {9, 1, 0}};
+  const RgbImage image = RenderTopDown(FloorAndWall(), trajectory, options);
+  EXPECT_GT(image.width, image.height) << "the map is wider than tall";
+  EXPECT_LE(std::max(image.width, image.height), 400);
+  ASSERT_EQ(image.pixels.size(), static_cast<size_t>(image.width * image.height * 3));
+
+  std::set<std::array<int, 3>> colours;
+  for (int y = 0; y < image.height; y += 3) {
+    for (int x = 0; x < image.width; x += 3) colours.insert(PixelAt(image, x, y));
+  }
+  EXPECT_GT(colours.size(), 10u) << "not a blank or flat image";
+
+  // Floor (low) is blue, the wall seen from above (high) red: compare the
+  // first and last map pixels down a column without trajectory.
+  const RgbImage plain = RenderTopDown(FloorAndWall(), {}, options);
+  const int column = plain.width / 3;
+  std::vector<std::array<int, 3>> down;
+  for (int y = 0; y < plain.height; ++y) {
+    const auto p = PixelAt(plain, column, y);
+    if (p != std::array<int, 3>{24, 24, 28}) down.push_back(p);
+  }
+  ASSERT_GT(down.size(), 10u);
+  EXPECT_GT(down.front()[0], down.front()[2]) << "the wall (top of the picture) is red";
+  EXPECT_GT(down.back()[2], down.back()[0]) << "the floor is blue";
+
+  // Green start mark and red end mark exist.
+  bool green = false, red = false;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const auto p = PixelAt(image, x, y);
+      green |= p == std::array<int, 3>{40, 220, 60};
+      red |= p == std::array<int, 3>{235, 40, 40};
+    }
+  }
+  EXPECT_TRUE(green);
+  EXPECT_TRUE(red);
+}
+
+TEST(MapPreview, RefusesNothingToDrawAndTinySizes) {
+  EXPECT_THROW(RenderTopDown(OccupiedCells{}, {}), InputError);
+  PreviewOptions tiny;
+  tiny.size_px = 10;
+  EXPECT_THROW(RenderTopDown(FloorAndWall(), {}, tiny), InputError);
+}
+
+TEST(MapPreview, WritesAPngOpen3dReadsBack) {
+  const fs::path dir = fs::temp_directory_path() / ("boicp_preview_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  PreviewOptions options;
+  options.size_px = 256;
+  const RgbImage image = RenderTopDown(FloorAndWall(), {}, options);
+  WritePng((dir / "p.png").string(), image);
+  open3d::geometry::Image read;
+  ASSERT_TRUE(open3d::io::ReadImage((dir / "p.png").string(), read));
+  EXPECT_EQ(read.width_, image.width);
+  EXPECT_EQ(read.height_, image.height);
+  EXPECT_EQ(read.num_of_channels_, 3);
+  EXPECT_TRUE(std::equal(image.pixels.begin(), image.pixels.end(), read.data_.begin()));
+  EXPECT_FALSE(HasStagingFile(dir));
+  fs::remove_all(dir);
+}
+
+TEST(MapPreview, ReadsOccupiedCellsOfBtAndOt) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("boicp_preview_bt_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  OccupancySettings settings;
+  settings.resolution = 0.5;
+  OccupancyMap map(settings);
+  Points wall;
+  for (double y = -2; y <= 2; y += 0.1) {
+    for (double z = 0; z <= 1; z += 0.1) wall.emplace_back(4.0, y, z);
+  }
+  map.InsertScan(wall, Transform::Identity(), Point::Zero());
+  map.WriteFull((dir / "m.ot").string());
+  map.WriteBinary((dir / "m.bt").string());
+  for (const char* name : {"m.bt", "m.ot"}) {
+    const OccupiedCells cells = ReadOccupiedCells((dir / name).string());
+    EXPECT_DOUBLE_EQ(cells.resolution, 0.5) << name;
+    ASSERT_FALSE(cells.centres.empty()) << name;
+    for (const Point& c : cells.centres) EXPECT_NEAR(c.x(), 4.0, 0.5) << name;
+  }
+  std::ofstream(dir / "bad.bt") << "hello\n";
+  try {
+    ReadOccupiedCells((dir / "bad.bt").string());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("bad.bt: not an OctoMap file"));
+  }
+  EXPECT_THROW(ReadOccupiedCells((dir / "none.bt").string()), InputError);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace boicp
