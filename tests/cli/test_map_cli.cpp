@@ -27,6 +27,7 @@
 #include "boicp/trajectory_io.hpp"
 
 #ifdef BOICP_TEST_WITH_DAEMON
+#include "../support/files_and_processes.hpp"
 #include "daemon_process.hpp"
 #include "map_builder_client.hpp"
 #endif
@@ -37,6 +38,9 @@
 
 namespace boicp {
 namespace {
+using boicp::test::RunCaptured;
+using boicp::test::RunResult;
+using boicp::test::Slurp;
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
@@ -48,16 +52,6 @@ std::string Quick(int seed = 5) {
   return " --config A --random-samples 4 --iterations 4 --rotation-bounds 0.2,0.2,3.14159"
          " --resolution 0.3 --seed " +
          std::to_string(seed);
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
 }
 
 int CountLines(const std::string& text) {
@@ -92,11 +86,7 @@ class MapCli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   RunResult Run(const std::string& args) {
-    const std::string command = std::string(BOICP_CLI_PATH) + " " + args + " >" +
-                                (dir_ / "stdout").string() + " 2>" + (dir_ / "stderr").string();
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(dir_ / "stdout"),
-            Slurp(dir_ / "stderr")};
+    return RunCaptured(std::string(BOICP_CLI_PATH) + " " + args, dir_);
   }
 
   // A generated drive of `n` .xyz scans, 2 m apart with a gentle turn.

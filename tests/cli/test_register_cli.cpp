@@ -12,21 +12,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include "../support/files_and_processes.hpp"
 
 namespace {
+using boicp::test::RunCaptured;
+using boicp::test::RunResult;
+using boicp::test::Slurp;
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
 
 class Cli : public ::testing::Test {
  protected:
@@ -39,10 +33,7 @@ class Cli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   RunResult Run(const std::string& args) {
-    const std::string command = std::string(BOICP_CLI_PATH) + " " + args + " >" +
-                                (dir_ / "out").string() + " 2>" + (dir_ / "err").string();
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(dir_ / "out"), Slurp(dir_ / "err")};
+    return RunCaptured(std::string(BOICP_CLI_PATH) + " " + args, dir_);
   }
 
   fs::path dir_;

@@ -25,33 +25,20 @@
 #include <open3d/io/ImageIO.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/files_and_processes.hpp"
 #include "daemon_process.hpp"
 #include "demo_sequence.hpp"
 
 namespace {
-
-// True when `dir` holds a staging file left by an atomic write.
-bool HasStagingFile(const std::filesystem::path& dir) {
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    if (entry.path().extension() == ".tmp") return true;
-  }
-  return false;
-}
+using boicp::test::HasStagingFile;
+using boicp::test::RunCaptured;
+using boicp::test::RunResult;
+using boicp::test::Slurp;
 
 using ::testing::HasSubstr;
 using ::testing::MatchesRegex;
 using ::testing::Not;
 namespace fs = std::filesystem;
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
 
 std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;
@@ -100,10 +87,7 @@ class RemoteCli : public ::testing::Test {
 
   // `boicp <args>` through the shell, as a script runs it.
   RunResult Run(const std::string& args, const std::string& env = "") {
-    const std::string command = env + " " + std::string(BOICP_CLI_PATH) + " " + args + " >" +
-                                (dir_ / "out").string() + " 2>" + (dir_ / "err").string();
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(dir_ / "out"), Slurp(dir_ / "err")};
+    return RunCaptured(env + " " + std::string(BOICP_CLI_PATH) + " " + args, dir_);
   }
 
   // A generated drive as a KITTI-like folder (velodyne/*.bin, no side

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/files_and_processes.hpp"
 #include "boicp/point_cloud_io.hpp"
 #include "boicp/synthetic_scene.hpp"
 
@@ -24,20 +25,12 @@
 
 namespace boicp {
 namespace {
+using boicp::test::RunResult;
+using boicp::test::Slurp;
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream file(path);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
 
 class ShardCli : public ::testing::Test {
  protected:

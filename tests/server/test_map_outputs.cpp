@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include "../support/files_and_processes.hpp"
 #include "boicp/map_assembly.hpp"
 #include "boicp/synthetic_scene.hpp"
 #include "boicp/trajectory_io.hpp"
@@ -15,14 +16,7 @@
 
 namespace boicp {
 namespace {
-
-// True when `dir` holds a staging file left by an atomic write.
-bool HasStagingFile(const std::filesystem::path& dir) {
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    if (entry.path().extension() == ".tmp") return true;
-  }
-  return false;
-}
+using boicp::test::HasStagingFile;
 
 namespace fs = std::filesystem;
 

@@ -11,19 +11,13 @@
 #include <open3d/geometry/Image.h>
 #include <open3d/io/ImageIO.h>
 
+#include "../support/files_and_processes.hpp"
 #include "boicp/map_preview.hpp"
 #include "boicp/occupancy_map.hpp"
 
 namespace boicp {
 namespace {
-
-// True when `dir` holds a staging file left by an atomic write.
-bool HasStagingFile(const std::filesystem::path& dir) {
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    if (entry.path().extension() == ".tmp") return true;
-  }
-  return false;
-}
+using boicp::test::HasStagingFile;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;

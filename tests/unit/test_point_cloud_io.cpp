@@ -21,6 +21,7 @@
 #include <open3d/io/ImageIO.h>
 #include <open3d/io/PointCloudIO.h>
 
+#include "../support/input_error.hpp"
 #include "boicp/point_cloud_io.hpp"
 
 #ifndef BOICP_SHARED_DATA_DIR
@@ -29,28 +30,13 @@
 
 namespace boicp {
 namespace {
+using boicp::test::InputErrorMessage;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Runs `load` and returns the InputError message, failing the test when
-// nothing (or something else) is thrown.
-template <typename Load>
-std::string InputErrorMessage(Load load) {
-  try {
-    load();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return {};
-}
 
 void ExpectPointNear(const Point& actual, const Point& expected, double tolerance = 1e-12) {
   EXPECT_NEAR(actual.x(), expected.x(), tolerance);

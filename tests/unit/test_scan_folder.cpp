@@ -11,6 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "../support/input_error.hpp"
 #include "boicp/scan_folder.hpp"
 
 #ifndef BOICP_SHARED_DATA_DIR
@@ -19,23 +20,10 @@
 
 namespace boicp {
 namespace {
+using boicp::test::InputErrorMessage;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-
-template <typename Call>
-std::string InputErrorMessage(Call call) {
-  try {
-    call();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return {};
-}
 
 void WriteText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());

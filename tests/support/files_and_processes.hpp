@@ -1,0 +1,42 @@
+#pragma once
+// Helpers the test suites share: reading a file whole, spotting staging files
+// an atomic write left behind, and running a command as a script would, with
+// its output captured. Header-only, so every test target can include it.
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace boicp::test {
+
+inline std::string Slurp(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+/// True when `dir` holds a staging file ("*.tmp") left by an atomic write.
+inline bool HasStagingFile(const std::filesystem::path& dir) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() == ".tmp") return true;
+  }
+  return false;
+}
+
+struct RunResult {
+  int exit_code = -1;  // -1 when the command did not exit normally
+  std::string out, err;
+};
+
+/// Runs `command` through the shell with stdout and stderr redirected to
+/// files in `scratch_dir` (which must exist), and returns both.
+inline RunResult RunCaptured(const std::string& command, const std::filesystem::path& scratch_dir) {
+  const std::filesystem::path out = scratch_dir / "stdout", err = scratch_dir / "stderr";
+  const int status = std::system((command + " >" + out.string() + " 2>" + err.string()).c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+}
+
+}  // namespace boicp::test
