@@ -31,6 +31,7 @@
 
 namespace {
 using boicp::test::HasStagingFile;
+using boicp::test::MakeSelfSignedCertificate;
 using boicp::test::RunCaptured;
 using boicp::test::RunResult;
 using boicp::test::Slurp;
@@ -346,11 +347,7 @@ TEST_F(RemoteCli, TokenIsRequiredAndNeverPrinted) {
 
 TEST_F(RemoteCli, TlsNeedsTheCaFile) {
   const std::string key = (dir_ / "key.pem").string(), cert = (dir_ / "cert.pem").string();
-  const std::string command =
-      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
-      "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " +
-      key + " -out " + cert + " >/dev/null 2>&1";
-  if (std::system(command.c_str()) != 0) GTEST_SKIP() << "openssl is not available";
+  if (!MakeSelfSignedCertificate(key, cert)) GTEST_SKIP() << "openssl is not available";
   StartDaemon({"--tls-cert", cert, "--tls-key", key});
 
   const RunResult secure = Run("health --tls-ca " + cert + server_);

@@ -5,6 +5,7 @@
 
 #include <gmock/gmock.h>
 
+#include "../support/files_and_processes.hpp"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpc/reflection/v1alpha/reflection.grpc.pb.h"
 #include "server_fixture.hpp"
@@ -118,11 +119,7 @@ TEST_F(ServiceExtras, UploadsEveryFormatAndDeduplicatesByContent) {
 
 TEST_F(ServiceExtras, ServesOverTls) {
   const std::string key = (dir_ / "key.pem").string(), cert = (dir_ / "cert.pem").string();
-  const std::string command =
-      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
-      "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " +
-      key + " -out " + cert + " >/dev/null 2>&1";
-  if (std::system(command.c_str()) != 0) GTEST_SKIP() << "openssl is not available";
+  if (!MakeSelfSignedCertificate(key, cert)) GTEST_SKIP() << "openssl is not available";
   StartDaemon({"--workers", "1", "--tls-cert", cert, "--tls-key", key});
 
   client::ConnectOptions tls;

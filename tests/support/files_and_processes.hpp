@@ -39,4 +39,15 @@ inline RunResult RunCaptured(const std::string& command, const std::filesystem::
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
 }
 
+/// Writes a one-day self-signed certificate for localhost and 127.0.0.1 to
+/// `cert_path`, and its key to `key_path`, with openssl. False when openssl
+/// is not available or fails.
+inline bool MakeSelfSignedCertificate(const std::string& key_path, const std::string& cert_path) {
+  const std::string command =
+      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
+      "-addext subjectAltName=DNS:localhost,IP:127.0.0.1 -keyout " +
+      key_path + " -out " + cert_path + " >/dev/null 2>&1";
+  return std::system(command.c_str()) == 0;
+}
+
 }  // namespace boicp::test
