@@ -2,8 +2,9 @@
 // Splits a BO-ICP run's wall time into ICP evaluations, the surrogate (GP
 // fitting and EI maximisation) and the final refinement, from RegisterPair's
 // callbacks alone: MinimiseBayesOpt polls stop_requested right before each
-// evaluation and RegisterPair reports progress right after it, so the time
-// between a poll and the next progress report is one ICP run plus its score.
+// round of evaluations and RegisterPair reports progress right after them, so
+// the time between a poll and the next progress report is one round of ICP
+// runs (concurrent when threads > 1) plus their scores.
 
 #include <chrono>
 #include <functional>

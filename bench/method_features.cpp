@@ -47,7 +47,7 @@ MethodOutput Refined(const Transform& initial, const FeatureCloud& source,
   const BoIcpConfig config = DatasetBoConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
   MethodOutput output;
-  output.transform = RefineCoarseToFine(initial, pair, config).transform;
+  output.transform = RefineCoarseToFine({initial}, pair, config).transform;
   output.evaluations = 1;
   output.source_points = source.cloud->points_.size();
   output.target_points = target.cloud->points_.size();

@@ -14,7 +14,7 @@ MethodOutput RunIcpFromIdentity(const MethodInput& input) {
                                              Transform::Identity(), SearchIcpOptions(config))
                                .transform;
   MethodOutput output;
-  output.transform = RefineCoarseToFine(coarse, pair, config).transform;
+  output.transform = RefineCoarseToFine({coarse}, pair, config).transform;
   output.evaluations = 1;
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();

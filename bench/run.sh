@@ -81,5 +81,6 @@ START=$(date +%s)
 # PASSIVE: threads sleep at OpenMP barriers instead of spinning (see main.cpp).
 OMP_WAIT_POLICY=PASSIVE OMP_NUM_THREADS="$THREADS" "$BIN" "${ARGS[@]}"
 "$PYTHON" "$ROOT/bench/plot.py" "$OUT"
+"$PYTHON" "$ROOT/bench/ratios.py" "$OUT"
 "$PYTHON" "$ROOT/bench/check_results.py" "$OUT" "$METHODS"
 echo "run.sh: done in $(( $(date +%s) - START )) s; results in $OUT"

@@ -151,7 +151,8 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
   app.add_option("--seed", f.seed, "Seed for every random choice")->capture_default_str();
   app.add_flag("--json", f.json, "Print one JSON object on stdout");
   app.add_flag("-q,--quiet", f.quiet, "No progress on stderr");
-  app.add_option("--threads", f.threads, "Threads for nearest-neighbour searches")
+  app.add_option("--threads", f.threads,
+                 "ICP runs of one BO round at once (the answer does not depend on it)")
       ->capture_default_str();
   app.add_option("--format", f.format, "auto, kitti, pcd, ply, xyz or depth")
       ->capture_default_str();
@@ -165,7 +166,7 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
   app.add_option("--prior", f.prior_file, "Initial guess: file with a 4x4 or 3x4 T_target_source");
   app.add_option("--voxel", f.voxel, "Search voxel size (metres)");
   app.add_option("--refine-voxel", f.refine_voxel,
-                 "Final ICP voxel size (metres; default voxel/3)");
+                 "Final ICP voxel size (metres; default voxel/4)");
   app.add_option("--max-correspondence", f.max_correspondence,
                  "ICP correspondence gate during the search (metres; default 3 x voxel)");
   app.add_option("--objective-truncation", f.truncation,

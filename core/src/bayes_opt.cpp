@@ -1,10 +1,13 @@
 #include "boicp/bayes_opt.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
 
+#include "boicp/parallel_for.hpp"
 #include "boicp/sampling.hpp"
 #include "boicp/types.hpp"
 
@@ -21,6 +24,8 @@ void ValidateOptions(const BayesOptOptions& o, const std::vector<bool>& periodic
           "initial_samples must be >= 1, got " + std::to_string(o.initial_samples));
   Require(o.iterations >= 0, "iterations must be >= 0, got " + std::to_string(o.iterations));
   Require(o.refit_every >= 1, "refit_every must be >= 1, got " + std::to_string(o.refit_every));
+  Require(o.batch_size >= 1, "batch_size must be >= 1, got " + std::to_string(o.batch_size));
+  Require(o.threads >= 1, "threads must be >= 1, got " + std::to_string(o.threads));
   Require(o.confidence_candidates >= 1,
           "confidence_candidates must be >= 1, got " + std::to_string(o.confidence_candidates));
   // Checked here too so a bad config fails before the first (costly) evaluation.
@@ -58,18 +63,34 @@ std::vector<Eigen::VectorXd> InitialDesign(const std::vector<Eigen::VectorXd>& i
   return design;
 }
 
-// Runs the objective and keeps history, incumbent and progress reporting.
+// Runs the objective a round at a time and keeps history, incumbent and
+// progress reporting.
 class Evaluator {
  public:
-  Evaluator(const UnitObjective& f, int total, const BayesOptProgress& progress,
+  Evaluator(const BoundedObjective& f, int total, int threads, const BayesOptProgress& progress,
             const std::function<bool()>& stop_requested, BayesOptResult& result)
-      : f_(f), total_(total), progress_(progress), stop_(stop_requested), result_(result) {
+      : f_(f),
+        total_(total),
+        threads_(threads),
+        progress_(progress),
+        stop_(stop_requested),
+        result_(result) {
     result_.history.reserve(static_cast<size_t>(total));
   }
 
-  void Evaluate(const Eigen::VectorXd& x) {
+  // Every point of a round is told the same incumbent, so the values do not
+  // depend on how many of them run at once.
+  void EvaluateRound(const std::vector<Eigen::VectorXd>& xs) {
     if (stop_ && stop_()) throw Cancelled();
-    const double y = f_(x);
+    const double incumbent =
+        result_.history.empty() ? std::numeric_limits<double>::infinity() : result_.best_y;
+    std::vector<double> values(xs.size());
+    ParallelFor(xs.size(), threads_, [&](size_t i) { values[i] = f_(xs[i], incumbent); });
+    for (size_t i = 0; i < xs.size(); ++i) Record(xs[i], values[i]);
+  }
+
+ private:
+  void Record(const Eigen::VectorXd& x, double y) {
     const size_t index = result_.history.size();
     if (!std::isfinite(y)) {
       std::ostringstream message;
@@ -86,9 +107,9 @@ class Evaluator {
     if (progress_) progress_(static_cast<int>(index) + 1, total_, result_.best_y);
   }
 
- private:
-  const UnitObjective& f_;
+  const BoundedObjective& f_;
   int total_;
+  int threads_;
   const BayesOptProgress& progress_;
   const std::function<bool()>& stop_;
   BayesOptResult& result_;
@@ -105,23 +126,58 @@ void HistoryAsData(const std::vector<BayesOptSample>& history, int d, Eigen::Mat
   }
 }
 
-// A full refit runs the multi-start likelihood search; between refits a single
-// L-BFGS run from the previous hyperparameters (restarts = 0) tracks the new
-// data at a fraction of the cost.
-void FitSurrogate(GaussianProcess& gp, const std::vector<BayesOptSample>& history,
-                  const GpFitOptions& fit, bool full_refit, std::mt19937_64& rng,
-                  const GpHyperparameters* warm_start) {
+// Keeps the surrogate up to date at three prices: a multi-start fit of the
+// hyperparameters (the first and the final fit), a single L-BFGS run from the
+// previous hyperparameters (every refit_every evaluations), or only
+// conditioning on the new data with them held, which at the n <= a few hundred
+// of a search is one small Cholesky factorisation.
+enum class SurrogateUpdate { kFullFit, kWarmFit, kCondition };
+
+void UpdateSurrogate(GaussianProcess& gp, const std::vector<BayesOptSample>& history,
+                     const GpFitOptions& fit, SurrogateUpdate update, std::mt19937_64& rng,
+                     const GpHyperparameters* previous) {
   Eigen::MatrixXd X;
   Eigen::VectorXd y;
   HistoryAsData(history, gp.dimension(), X, y);
-  GpFitOptions options = fit;
-  if (!full_refit) options.restarts = 0;
-  gp.Fit(X, y, options, rng, warm_start);
+  if (previous == nullptr || update == SurrogateUpdate::kFullFit) {
+    gp.Fit(X, y, fit, rng, previous);
+  } else if (update == SurrogateUpdate::kWarmFit) {
+    GpFitOptions warm = fit;
+    warm.restarts = 0;
+    gp.Fit(X, y, warm, rng, previous);
+  } else {
+    gp.Condition(X, y, *previous);
+  }
+}
+
+// Kriging believer: after each proposal the GP (hyperparameters held) is told
+// that the objective there equals its own prediction, which flattens EI around
+// it so the next proposal goes elsewhere. q = 1 is plain expected improvement.
+std::vector<Eigen::VectorXd> ProposeRound(GaussianProcess gp,
+                                          const std::vector<BayesOptSample>& history, double best,
+                                          int q, const AcquisitionOptions& acquisition,
+                                          std::mt19937_64& rng) {
+  Eigen::MatrixXd X;
+  Eigen::VectorXd y;
+  HistoryAsData(history, gp.dimension(), X, y);
+  std::vector<Eigen::VectorXd> proposals;
+  for (int j = 0; j < q; ++j) {
+    proposals.push_back(MaximiseExpectedImprovement(gp, best, acquisition, rng));
+    if (j + 1 == q) break;
+    const double believed = gp.Predict(proposals.back()).mean;
+    X.conservativeResize(X.rows() + 1, Eigen::NoChange);
+    X.row(X.rows() - 1) = proposals.back().transpose();
+    y.conservativeResize(y.size() + 1);
+    y(y.size() - 1) = believed;
+    best = std::min(best, believed);
+    gp.Condition(X, y, gp.hyperparameters());
+  }
+  return proposals;
 }
 
 }  // namespace
 
-BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points,
                                 const BayesOptProgress& progress,
@@ -132,23 +188,37 @@ BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>&
   const std::vector<Eigen::VectorXd> design =
       InitialDesign(initial_points, options.initial_samples, d, rng);
   const int total = static_cast<int>(design.size()) + options.iterations;
+  const auto q = static_cast<size_t>(options.batch_size);
 
   BayesOptResult result;
-  Evaluator evaluator(f, total, progress, stop_requested, result);
-  for (const Eigen::VectorXd& x : design) evaluator.Evaluate(x);
-
-  GaussianProcess gp(periodic);
-  GpHyperparameters last;
-  bool have_last = false;
-  for (int step = 0; step < options.iterations; ++step) {
-    FitSurrogate(gp, result.history, options.fit, step % options.refit_every == 0, rng,
-                 have_last ? &last : nullptr);
-    last = gp.hyperparameters();
-    have_last = true;
-    evaluator.Evaluate(MaximiseExpectedImprovement(gp, result.best_y, options.acquisition, rng));
+  Evaluator evaluator(f, total, options.threads, progress, stop_requested, result);
+  for (size_t first = 0; first < design.size(); first += q) {
+    evaluator.EvaluateRound(
+        {design.begin() + static_cast<std::ptrdiff_t>(first),
+         design.begin() + static_cast<std::ptrdiff_t>(std::min(first + q, design.size()))});
   }
 
-  FitSurrogate(gp, result.history, options.fit, true, rng, have_last ? &last : nullptr);
+  GaussianProcess gp(periodic);
+  GpHyperparameters fitted;
+  bool have_fit = false;
+  int since_fit = 0;
+  for (int done = 0; done < options.iterations;) {
+    const int round = std::min(options.batch_size, options.iterations - done);
+    const bool refit = !have_fit || since_fit >= options.refit_every;
+    UpdateSurrogate(gp, result.history, options.fit,
+                    refit ? SurrogateUpdate::kWarmFit : SurrogateUpdate::kCondition, rng,
+                    have_fit ? &fitted : nullptr);
+    if (refit) since_fit = 0;
+    fitted = gp.hyperparameters();
+    have_fit = true;
+    evaluator.EvaluateRound(
+        ProposeRound(gp, result.history, result.best_y, round, options.acquisition, rng));
+    done += round;
+    since_fit += round;
+  }
+
+  UpdateSurrogate(gp, result.history, options.fit, SurrogateUpdate::kFullFit, rng,
+                  have_fit ? &fitted : nullptr);
   const GpPrediction at_best = gp.Predict(result.best_x);
   result.gp_mean_at_best = at_best.mean;
   result.gp_std_at_best = at_best.std;
@@ -156,6 +226,16 @@ BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>&
                                                           options.confidence_candidates, rng);
   result.hyperparameters = gp.hyperparameters();
   return result;
+}
+
+BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,
+                                const BayesOptOptions& options, uint64_t seed,
+                                const std::vector<Eigen::VectorXd>& initial_points,
+                                const BayesOptProgress& progress,
+                                const std::function<bool()>& stop_requested) {
+  const BoundedObjective unbounded = [&f](const Eigen::VectorXd& x, double) { return f(x); };
+  return MinimiseBayesOpt(unbounded, periodic, options, seed, initial_points, progress,
+                          stop_requested);
 }
 
 }  // namespace boicp

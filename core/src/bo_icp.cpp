@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
+#include <mutex>
+#include <utility>
 
 #include "boicp/alignment_score.hpp"
 #include "boicp/icp.hpp"
@@ -37,21 +40,33 @@ class Search {
     BayesOptOptions options = config_.bo;
     options.initial_samples = config_.random_samples;
     options.iterations = config_.iterations;
-    const int total = options.initial_samples + options.iterations;
-    int done = 0;
-    double best = 0.0;
-    const UnitObjective objective = [&](const Eigen::VectorXd& u) {
-      const double value = Evaluate(stage, space.ToTransform(u));
-      best = done == 0 ? value : std::min(best, value);
-      ++done;
+    options.threads = config_.threads;
+    std::mutex mutex;
+    std::vector<std::pair<Eigen::VectorXd, Evaluation>> finished;
+    // Only translation-only stages abandon hopeless starts: a start that must
+    // rotate slides slowly and then snaps into its basin, so its recent
+    // progress says little about where it ends (measured on 7-Scenes:
+    // abandoning in the rotation stage lost the true basin on 1 of 4 pairs).
+    const bool may_abandon = config_.abandon_hopeless && !space.SearchesRotation();
+    const BoundedObjective objective = [&](const Eigen::VectorXd& u, double incumbent) {
+      const Evaluation evaluation =
+          Evaluate(stage, space.ToTransform(u),
+                   may_abandon ? incumbent : std::numeric_limits<double>::infinity());
+      const std::lock_guard<std::mutex> lock(mutex);
+      finished.emplace_back(u, evaluation);
+      return evaluation.objective;
+    };
+    const BayesOptProgress progress = [&](int done, int total, double best) {
       if (callbacks_.progress) callbacks_.progress({name, done, total, best});
-      return value;
     };
     std::vector<Eigen::VectorXd> starts = {Eigen::VectorXd::Constant(space.dimension(), 0.5)};
     starts.insert(starts.end(), extra_starts.begin(), extra_starts.end());
-    return MinimiseBayesOpt(objective, space.Periodic(), options,
-                            config_.seed ^ (kStageSalt * static_cast<uint64_t>(stage + 1)), starts,
-                            {}, callbacks_.stop_requested);
+    BayesOptResult result =
+        MinimiseBayesOpt(objective, space.Periodic(), options,
+                         config_.seed ^ (kStageSalt * static_cast<uint64_t>(stage + 1)), starts,
+                         progress, callbacks_.stop_requested);
+    AppendInProposalOrder(result.history, finished);
+    return result;
   }
 
   const Evaluation& Best() const {
@@ -62,18 +77,37 @@ class Search {
   std::vector<Evaluation>& history() { return history_; }
 
  private:
-  // The paper's objective: the error ICP reaches when started from T0.
-  double Evaluate(int stage, const Transform& initial) {
+  // The paper's objective: the error ICP reaches when started from T0. Runs
+  // that cannot get below `abandon_above` are abandoned early.
+  Evaluation Evaluate(int stage, const Transform& initial, double abandon_above) const {
     const NearestNeighborIndex& target = pair_.prepared.search_target;
-    const Transform aligned =
-        callbacks_.local_icp
-            ? callbacks_.local_icp(pair_.evaluation_source, target.points(), initial)
-            : AlignPointToPoint(pair_.evaluation_source, target, initial, pair_.search_icp)
-                  .transform;
-    const AlignmentScore score = ScoreAlignment(pair_.evaluation_source, target, aligned,
-                                                config_.EffectiveTruncation(), config_.threads);
-    history_.push_back({stage, initial, aligned, score.truncated_mean});
-    return score.truncated_mean;
+    Evaluation evaluation{stage, initial, initial, 0.0, false};
+    if (callbacks_.local_icp) {
+      evaluation.result = callbacks_.local_icp(pair_.evaluation_source, target.points(), initial);
+    } else {
+      IcpOptions options = pair_.search_icp;
+      options.abandon_above = abandon_above;
+      options.truncation = config_.EffectiveTruncation();
+      const IcpResult icp = AlignPointToPoint(pair_.evaluation_source, target, initial, options);
+      evaluation.result = icp.transform;
+      evaluation.abandoned = icp.abandoned;
+    }
+    evaluation.objective = ScoreAlignment(pair_.evaluation_source, target, evaluation.result,
+                                          config_.EffectiveTruncation())
+                               .truncated_mean;
+    return evaluation;
+  }
+
+  // Evaluations of a round finish in any order; the history keeps the order
+  // in which BO proposed them, so it does not depend on the thread count.
+  void AppendInProposalOrder(const std::vector<BayesOptSample>& proposals,
+                             std::vector<std::pair<Eigen::VectorXd, Evaluation>>& finished) {
+    for (const BayesOptSample& sample : proposals) {
+      const auto match = std::find_if(finished.begin(), finished.end(),
+                                      [&](const auto& entry) { return entry.first == sample.x; });
+      history_.push_back(match->second);
+      finished.erase(match);
+    }
   }
 
   const PairContext& pair_;
@@ -167,23 +201,12 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
 
   // The search objective is measured on coarse voxels; a few distinct
   // candidates are refined and the one that fits best at the finest level wins.
-  const std::vector<Evaluation> candidates =
-      DistinctBest(search.history(), config.refine_candidates, config.voxel);
-  RefinedAlignment final_alignment;
-  for (size_t k = 0; k < candidates.size(); ++k) {
-    if (callbacks.progress) {
-      callbacks.progress(
-          {"refine", static_cast<int>(k), static_cast<int>(candidates.size()), best.objective});
-    }
-    const RefinedAlignment refined = RefineCoarseToFine(candidates[k].result, prepared, config);
-    if (k == 0 || refined.score.truncated_mean < final_alignment.score.truncated_mean) {
-      final_alignment = refined;
-    }
-  }
-  if (callbacks.progress) {
-    const int n = static_cast<int>(candidates.size());
-    callbacks.progress({"refine", n, n, best.objective});
-  }
+  std::vector<Transform> candidates;
+  for (const Evaluation& e : DistinctBest(search.history(), config.refine_candidates, config.voxel))
+    candidates.push_back(e.result);
+  if (callbacks.progress) callbacks.progress({"refine", 0, 1, best.objective});
+  const RefinedAlignment final_alignment = RefineCoarseToFine(candidates, prepared, config);
+  if (callbacks.progress) callbacks.progress({"refine", 1, 1, best.objective});
 
   result.transform = final_alignment.transform;
   result.objective = best.objective;
@@ -193,6 +216,9 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   result.gp_mean = last.gp_mean_at_best;
   result.gp_std = last.gp_std_at_best;
   result.evaluations = static_cast<int>(search.history().size());
+  result.abandoned =
+      static_cast<int>(std::count_if(search.history().begin(), search.history().end(),
+                                     [](const Evaluation& e) { return e.abandoned; }));
   result.source_points = search_source.size();
   result.target_points = prepared.search_target.size();
   result.history = std::move(search.history());

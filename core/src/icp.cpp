@@ -1,5 +1,6 @@
 #include "boicp/icp.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,7 +24,11 @@ void MatchNearest(const Points& source, const NearestNeighborIndex& target,
     moved[i] = R * source[i] + t;
     size_t index = 0;
     double d2 = 0.0;
-    if (target.Nearest(moved[i], max_sq_distance, index, d2)) {
+    // The previous iteration's match is close after a small step and bounds the search.
+    const bool found = match[i] == kNoMatch
+                           ? target.Nearest(moved[i], max_sq_distance, index, d2)
+                           : target.NearestWithHint(moved[i], match[i], max_sq_distance, index, d2);
+    if (found) {
       match[i] = index;
       sq_distance[i] = d2;
     } else {
@@ -32,7 +37,23 @@ void MatchNearest(const Points& source, const NearestNeighborIndex& target,
   }
 }
 
+// Mean of every point's distance clipped at tau; unmatched points (beyond the
+// gate, which is at least tau) count as tau.
+double TruncatedMean(const std::vector<size_t>& match, const std::vector<double>& sq_distance,
+                     double tau) {
+  double sum = 0.0;
+  for (size_t i = 0; i < match.size(); ++i) {
+    sum += match[i] == kNoMatch ? tau : std::min(std::sqrt(sq_distance[i]), tau);
+  }
+  return sum / static_cast<double>(std::max<size_t>(match.size(), 1));
+}
+
 }  // namespace
+
+double ProjectedLimit(double f0, double f1, double f2, int remaining_steps) {
+  const double fastest = std::max({f0 - f1, f1 - f2, 0.0});
+  return f2 - fastest * static_cast<double>(std::max(remaining_steps, 0));
+}
 
 Transform RigidFromCrossCovariance(const Point& source_mean, const Point& target_mean,
                                    const Eigen::Matrix3d& cross_covariance) {
@@ -57,6 +78,13 @@ IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& ta
   std::vector<double> sq_distance(source.size(), 0.0);
   const double max_sq = options.max_correspondence_distance * options.max_correspondence_distance;
   const Points& target_points = target.points();
+  const bool may_abandon = std::isfinite(options.abandon_above);
+  if (may_abandon &&
+      !(options.truncation > 0.0 && options.truncation <= options.max_correspondence_distance)) {
+    throw InputError("ICP: abandoning needs 0 < truncation <= max_correspondence_distance");
+  }
+  // Truncated means of the last three iterations, oldest first.
+  double history[3] = {0.0, 0.0, 0.0};
 
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     const Eigen::Matrix3d R = result.transform.topLeftCorner<3, 3>();
@@ -82,6 +110,17 @@ IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& ta
       return result;
     }
     result.rmse = std::sqrt(sum_sq / static_cast<double>(count));
+    if (may_abandon) {
+      history[0] = history[1];
+      history[1] = history[2];
+      history[2] = TruncatedMean(match, sq_distance, options.truncation);
+      if (iteration + 1 >= std::max(options.abandon_after, 3) &&
+          ProjectedLimit(history[0], history[1], history[2],
+                         options.max_iterations - iteration - 1) > options.abandon_above) {
+        result.abandoned = true;
+        return result;
+      }
+    }
     source_mean /= static_cast<double>(count);
     target_mean /= static_cast<double>(count);
     Eigen::Matrix3d cross_covariance = Eigen::Matrix3d::Zero();

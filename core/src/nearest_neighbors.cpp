@@ -23,6 +23,9 @@ struct PointsAdaptor {
 class BoundedNearestResult {
  public:
   explicit BoundedNearestResult(double max_squared_distance) : worst_(max_squared_distance) {}
+  // Starts from a known candidate: only strictly closer points replace it.
+  BoundedNearestResult(double squared_distance, size_t index)
+      : worst_(squared_distance), index_(index), found_(true) {}
   bool addPoint(double squared_distance, size_t index) {
     if (squared_distance < worst_) {
       worst_ = squared_distance;
@@ -70,6 +73,20 @@ bool NearestNeighborIndex::Nearest(const Point& query, double max_squared_distan
   BoundedNearestResult result(max_squared_distance);
   tree_->kdtree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   if (!result.full()) return false;
+  index = result.index();
+  squared_distance = result.worstDist();
+  return true;
+}
+
+bool NearestNeighborIndex::NearestWithHint(const Point& query, size_t hint,
+                                           double max_squared_distance, size_t& index,
+                                           double& squared_distance) const {
+  const double hint_squared = (tree_->adaptor.points[hint] - query).squaredNorm();
+  if (!(hint_squared < max_squared_distance)) {
+    return Nearest(query, max_squared_distance, index, squared_distance);
+  }
+  BoundedNearestResult result(hint_squared, hint);
+  tree_->kdtree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   index = result.index();
   squared_distance = result.worstDist();
   return true;

@@ -1,5 +1,6 @@
 #include "boicp/search_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace boicp {
@@ -43,6 +44,11 @@ SearchSpace MakeSearchSpace(const Transform& anchor, const Point& pivot,
     if (space.half_widths[p] > 0.0) space.parameters.push_back(static_cast<SearchParameter>(p));
   }
   return space;
+}
+
+bool SearchSpace::SearchesRotation() const {
+  return std::any_of(parameters.begin(), parameters.end(),
+                     [](SearchParameter p) { return p < kX; });
 }
 
 }  // namespace boicp

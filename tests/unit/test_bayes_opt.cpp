@@ -137,6 +137,52 @@ TEST(BayesOptTest, SameSeedGivesIdenticalHistory) {
   EXPECT_FALSE(a.history.back().x == c.history.back().x);
 }
 
+// Batch-parallel BO: q proposals per round, evaluated on `threads` threads.
+// The answer depends on q only; threads = 1 is the serial twin.
+class BayesOptBatches : public ::testing::TestWithParam<int> {};
+
+TEST_P(BayesOptBatches, ParallelRoundsEqualTheirSerialTwin) {
+  BayesOptOptions options = Budget(5, 9);
+  options.batch_size = GetParam();
+  const BayesOptResult serial = MinimiseBayesOpt(BraninUnit, {false, false}, options, 11);
+  options.threads = 2;
+  const BayesOptResult parallel = MinimiseBayesOpt(BraninUnit, {false, false}, options, 11);
+  ASSERT_EQ(serial.history.size(), 14u);
+  ASSERT_EQ(parallel.history.size(), serial.history.size());
+  for (size_t i = 0; i < serial.history.size(); ++i) {
+    EXPECT_TRUE(serial.history[i].x == parallel.history[i].x) << "evaluation " << i;
+    EXPECT_EQ(serial.history[i].y, parallel.history[i].y) << "evaluation " << i;
+  }
+  EXPECT_EQ(serial.probability_better, parallel.probability_better);
+}
+
+TEST_P(BayesOptBatches, ProposalsOfARoundAreDistinctAndToldThePreviousRoundsBest) {
+  const int q = GetParam();
+  BayesOptOptions options = Budget(4, 8);
+  options.batch_size = q;
+  std::vector<double> incumbents;
+  std::vector<double> values;
+  const BoundedObjective f = [&](const Eigen::VectorXd& x, double incumbent) {
+    incumbents.push_back(incumbent);
+    values.push_back(BraninUnit(x));
+    return values.back();
+  };
+  const BayesOptResult result = MinimiseBayesOpt(f, {false, false}, options, 3);
+  ASSERT_EQ(values.size(), 12u);
+  for (size_t i = 0; i < values.size(); ++i) {
+    const size_t round_start = i < 4 ? i - i % q : 4 + (i - 4) - (i - 4) % q;
+    double before = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < round_start; ++k) before = std::min(before, values[k]);
+    EXPECT_EQ(incumbents[i], before) << "evaluation " << i;
+    if (i > round_start) {
+      EXPECT_FALSE(result.history[i].x.isApprox(result.history[i - 1].x, 1e-6))
+          << "evaluation " << i << " repeats its round's previous proposal";
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BatchSizes, BayesOptBatches, ::testing::Values(1, 2, 3));
+
 TEST(BayesOptTest, ReportsProgressAndKeepsInitialPointsFirst) {
   const std::vector<Eigen::VectorXd> initial = {Eigen::Vector2d(0.25, 1.5),
                                                 Eigen::Vector2d(0.5, 0.5)};
@@ -181,8 +227,17 @@ TEST(BayesOptTest, StopRequestThrowsCancelledBeforeTheNextEvaluation) {
     return BraninUnit(x);
   };
   const std::function<bool()> stop = [&] { return ++polls > 7; };
-  EXPECT_THROW(MinimiseBayesOpt(f, {false, false}, Budget(5, 10), 1, {}, {}, stop), Cancelled);
+  BayesOptOptions one_at_a_time = Budget(5, 10);
+  one_at_a_time.batch_size = 1;
+  EXPECT_THROW(MinimiseBayesOpt(f, {false, false}, one_at_a_time, 1, {}, {}, stop), Cancelled);
   EXPECT_EQ(evaluations, 7);
+
+  // In rounds of q = 2 the poll comes before each round: 5 design points take
+  // 3 rounds, so 7 polls allow 3 + 4 rounds = 13 evaluations.
+  evaluations = 0;
+  polls = 0;
+  EXPECT_THROW(MinimiseBayesOpt(f, {false, false}, Budget(5, 10), 1, {}, {}, stop), Cancelled);
+  EXPECT_EQ(evaluations, 13);
 }
 
 TEST(BayesOptTest, InvalidOptionsThrowInputError) {
@@ -194,6 +249,12 @@ TEST(BayesOptTest, InvalidOptionsThrowInputError) {
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
   o = Budget(3, 3);
   o.refit_every = 0;
+  EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
+  o = Budget(3, 3);
+  o.batch_size = 0;
+  EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
+  o = Budget(3, 3);
+  o.threads = 0;
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
   EXPECT_THROW(MinimiseBayesOpt(f, {}, Budget(3, 3), 1), InputError);
   EXPECT_THROW(MinimiseBayesOpt(f, two, Budget(3, 3), 1, {Eigen::Vector3d(0.1, 0.2, 0.3)}),

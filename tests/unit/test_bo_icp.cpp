@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
+
 #include "boicp/bo_icp.hpp"
 #include "boicp/evaluation.hpp"
 #include "boicp/icp.hpp"
@@ -59,10 +62,44 @@ TEST(BoIcp, SameSeedSameAnswerAndThreadCountDoesNotMatter) {
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 5;
   const RegistrationResult a = RegisterPair(pair.source, pair.target, config);
-  config.threads = 2;
+  config.threads = 2;  // the parallel twin: the same rounds, evaluated two at a time
   const RegistrationResult b = RegisterPair(pair.source, pair.target, config);
   EXPECT_TRUE(a.transform == b.transform);
   EXPECT_EQ(a.objective, b.objective);
+  ASSERT_EQ(a.history.size(), b.history.size());
+  for (size_t i = 0; i < a.history.size(); ++i) {
+    EXPECT_TRUE(a.history[i].initial == b.history[i].initial) << "evaluation " << i;
+    EXPECT_EQ(a.history[i].objective, b.history[i].objective) << "evaluation " << i;
+  }
+}
+
+TEST(BoIcp, OnlyTheTranslationStageAbandonsStartsAndNeverItsBest) {
+  const StreetPair pair = MakeStreetPair(2.3);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.abandon_hopeless = true;
+  const RegistrationResult result = RegisterPair(pair.source, pair.target, config);
+  int abandoned = 0;
+  double best_translation = std::numeric_limits<double>::infinity();
+  for (const Evaluation& e : result.history) {
+    if (e.stage == 0) {
+      EXPECT_FALSE(e.abandoned) << "the rotation stage never abandons";
+    }
+    if (e.stage == 1 && !e.abandoned) best_translation = std::min(best_translation, e.objective);
+    abandoned += e.abandoned ? 1 : 0;
+  }
+  EXPECT_EQ(result.abandoned, abandoned);
+  EXPECT_GT(abandoned, 0);
+  // An abandoned start could not beat the incumbent of its round, which is at
+  // least the stage's best.
+  for (const Evaluation& e : result.history) {
+    if (e.abandoned) {
+      EXPECT_GT(e.objective, best_translation);
+    }
+  }
+
+  BoIcpConfig keep_all = config;
+  keep_all.abandon_hopeless = false;
+  EXPECT_EQ(RegisterPair(pair.source, pair.target, keep_all).abandoned, 0);
 }
 
 TEST(BoIcp, PriorIsTheFirstSample) {
@@ -80,6 +117,7 @@ TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
   const StreetPair pair = MakeStreetPair(0.9);
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 3;
+  config.abandon_hopeless = false;  // the hook runs every ICP to the end
   const RegistrationResult plain = RegisterPair(pair.source, pair.target, config);
 
   // A hook that runs core's own ICP must reproduce the search exactly...

@@ -58,6 +58,45 @@ TEST(Icp, SerialAndParallelGiveIdenticalResults) {
   EXPECT_EQ(sa.fitness, sb.fitness);
 }
 
+TEST(Icp, ProjectedLimitExtrapolatesTheFasterOfTheLastTwoSteps) {
+  EXPECT_NEAR(ProjectedLimit(1.0, 0.8, 0.7, 3), 0.7 - 0.2 * 3, 1e-12);
+  EXPECT_NEAR(ProjectedLimit(1.0, 0.9, 0.7, 2), 0.7 - 0.2 * 2, 1e-12);
+  EXPECT_DOUBLE_EQ(ProjectedLimit(0.5, 0.6, 0.6, 10), 0.6);  // not decreasing: stays
+  EXPECT_DOUBLE_EQ(ProjectedLimit(1.0, 0.8, 0.7, 0), 0.7);   // no steps left
+}
+
+TEST(Icp, AbandonsOnlyRunsThatCannotBeatTheBound) {
+  const Points target = StreetSample();
+  const Points source = TransformPoints(SmallMotion().inverse(), target);
+  const NearestNeighborIndex index(target);
+  IcpOptions options;
+  options.max_correspondence_distance = 1.0;
+  options.max_iterations = 40;
+  const IcpResult full = AlignPointToPoint(source, index, Transform::Identity(), options);
+  ASSERT_FALSE(full.abandoned);
+  const double start = ScoreAlignment(source, index, Transform::Identity(), 0.5).truncated_mean;
+  ASSERT_LT(ScoreAlignment(source, index, full.transform, 0.5).truncated_mean, start);
+
+  options.truncation = 0.5;
+  // A bound the run is below from its first step: it runs exactly as without one.
+  options.abandon_above = start;
+  const IcpResult bounded = AlignPointToPoint(source, index, Transform::Identity(), options);
+  EXPECT_FALSE(bounded.abandoned);
+  EXPECT_TRUE(bounded.transform == full.transform);
+  EXPECT_EQ(bounded.iterations, full.iterations);
+
+  // A bound below anything reachable: given up after abandon_after iterations,
+  // and the score there is above the bound.
+  options.abandon_above = -1.0;
+  const IcpResult hopeless = AlignPointToPoint(source, index, Transform::Identity(), options);
+  EXPECT_TRUE(hopeless.abandoned);
+  EXPECT_EQ(hopeless.iterations, options.abandon_after);
+  EXPECT_GT(ScoreAlignment(source, index, hopeless.transform, 0.5).truncated_mean, -1.0);
+
+  options.truncation = 2.0;  // beyond the gate: distances there were never measured
+  EXPECT_THROW(AlignPointToPoint(source, index, Transform::Identity(), options), InputError);
+}
+
 TEST(Icp, StopsWithoutCorrespondences) {
   const Points target = {Point(0, 0, 0), Point(1, 0, 0), Point(0, 1, 0)};
   const Points source = {Point(100, 0, 0), Point(101, 0, 0), Point(100, 1, 0)};

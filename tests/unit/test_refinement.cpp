@@ -35,10 +35,29 @@ TEST(Refinement, RecoversATransformFromAStartInsideTheBasin) {
   const BoIcpConfig config = StreetConfig();
   const PreparedPair pair = PreparePair(source, target, config);
 
-  const RefinedAlignment refined = RefineCoarseToFine(Transform::Identity(), pair, config);
+  const RefinedAlignment refined = RefineCoarseToFine({Transform::Identity()}, pair, config);
   EXPECT_LT(RotationAngle(refined.transform.inverse() * truth), 1e-3);
   EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
   EXPECT_GT(refined.score.fitness, 0.99);
+}
+
+TEST(Refinement, TheStartThatFitsBestWinsWhateverItsPlaceInTheList) {
+  const Points world = MakeSyntheticStreet(7, 30.0);
+  const Transform truth = PoseFromYawTranslation(0.05, {0.4, -0.3, 0.0});
+  const Points target = SimulateScan(world, Transform::Identity(), 40.0, 0.0, 1);
+  const Points source = TransformPoints(truth.inverse(), target);
+  const BoIcpConfig config = StreetConfig();
+  const PreparedPair pair = PreparePair(source, target, config);
+  const Transform wrong = PoseFromYawTranslation(M_PI, {3.0, 1.0, 0.0});  // another basin
+
+  for (const std::vector<Transform>& starts :
+       {std::vector<Transform>{Transform::Identity(), wrong},
+        std::vector<Transform>{wrong, Transform::Identity()}}) {
+    const RefinedAlignment refined = RefineCoarseToFine(starts, pair, config);
+    EXPECT_LT(RotationAngle(refined.transform.inverse() * truth), 1e-3);
+    EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
+  }
+  EXPECT_THROW(RefineCoarseToFine({}, pair, config), InputError);
 }
 
 TEST(Refinement, CloudEmptiedByCroppingIsAnInputErrorNamingIt) {

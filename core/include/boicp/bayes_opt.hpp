@@ -1,6 +1,7 @@
 #pragma once
 // Bayesian optimisation of a black-box function on the unit box: N_r
-// space-filling samples, then N expected-improvement steps on a Matern 5/2 GP.
+// space-filling samples, then N expected-improvement steps on a Matern 5/2 GP,
+// proposed and evaluated q at a time.
 
 #include <cstdint>
 #include <functional>
@@ -16,7 +17,14 @@ namespace boicp {
 struct BayesOptOptions {
   int initial_samples = 10;  // N_r: Latin-hypercube samples before the GP guides the search
   int iterations = 20;       // N: expected-improvement steps after the initial samples
-  int refit_every = 1;       // refit GP hyperparameters every k steps (warm-started between)
+  // Evaluations between fits of the GP hyperparameters; in between, the GP is
+  // only conditioned on the new data with the hyperparameters held.
+  int refit_every = 5;
+  // q: points proposed per round (kriging believer: each proposal is added to
+  // the GP at its predicted mean before the next is chosen) and evaluated
+  // together. The answer depends on q, never on `threads`.
+  int batch_size = 2;
+  int threads = 1;  // evaluations of one round run at once (the objective must be thread-safe)
   GpFitOptions fit;
   AcquisitionOptions acquisition;
   int confidence_candidates = 2000;  // points scanned for MaxProbabilityOfImprovement at the end
@@ -40,24 +48,38 @@ struct BayesOptResult {
 
 using UnitObjective = std::function<double(const Eigen::VectorXd& unit_x)>;
 
+/// An objective told the value it has to beat to matter: the best value found
+/// before the current round (+infinity in the first). Below it, it must return
+/// f(x); once it knows it cannot get below, it may stop early and return any
+/// value above it. Called concurrently when options.threads > 1.
+using BoundedObjective = std::function<double(const Eigen::VectorXd& unit_x, double incumbent)>;
+
 /// Called after each evaluation with the number done and the total planned.
 using BayesOptProgress = std::function<void(int done, int total, double best_y)>;
 
-/// Minimises f over [0,1]^d with d = periodic.size(). `initial_points` (rows in
+/// Minimises f over [0,1]^d with d = periodic.size(). Evaluations run in
+/// rounds of options.batch_size points (the initial design too). `initial_points` (rows in
 /// the box, for example a prior guess) replace the first Latin-hypercube
 /// samples. `stop_requested`, if set, is polled between evaluations and ends
 /// the search by throwing boicp::Cancelled. Reproducible for a given seed.
 /// f must return finite values.
 ///
 /// Details: if initial_points.size() >= initial_samples only the initial
-/// points are used; each is clamped into the box. Before EI step `s` the GP is
-/// refitted with options.fit (warm start + restarts) when s % refit_every == 0,
-/// otherwise with a single L-BFGS run warm-started from the previous
-/// hyperparameters. progress is called after every evaluation. Invalid options,
+/// points are used; each is clamped into the box. Before an EI round the GP
+/// hyperparameters are fitted with options.fit (warm start + restarts) when
+/// refit_every evaluations have come in since the last fit, and held
+/// otherwise. progress is called after every evaluation, in proposal order. Invalid options,
 /// malformed initial points and non-finite objective values (the message names
 /// the 0-based evaluation index) throw boicp::InputError. One
 /// std::mt19937_64(seed) drives every random choice, so a seed reproduces the
 /// run bit for bit.
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+                                const BayesOptOptions& options, uint64_t seed,
+                                const std::vector<Eigen::VectorXd>& initial_points = {},
+                                const BayesOptProgress& progress = {},
+                                const std::function<bool()>& stop_requested = {});
+
+/// The same for an objective that always returns f(x).
 BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points = {},

@@ -19,6 +19,7 @@ struct Evaluation {
   Transform initial = Transform::Identity();  // T0 that BO proposed
   Transform result = Transform::Identity();   // where ICP took it
   double objective = 0.0;                     // truncated mean distance after ICP, metres
+  bool abandoned = false;  // ICP stopped early: it could not beat the incumbent of its round
 };
 
 /// Result of registering one pair. Frame convention: `transform` is
@@ -36,6 +37,7 @@ struct RegistrationResult {
   double gp_std = 0.0;              // GP posterior standard deviation there, metres
   double probability_better = 0.0;  // max over stages of the GP's P(some other point is better)
   int evaluations = 0;              // ICP runs made by the search
+  int abandoned = 0;                // of which stopped early as unable to win
   double runtime_s = 0.0;           // wall time of RegisterPair
   size_t source_points = 0;         // after search downsampling
   size_t target_points = 0;
@@ -51,9 +53,10 @@ struct RegistrationProgress {
 
 struct RegistrationCallbacks {
   std::function<void(const RegistrationProgress&)> progress;
-  std::function<bool()> stop_requested;  // polled between evaluations; true -> boicp::Cancelled
+  std::function<bool()> stop_requested;  // polled between rounds; true -> boicp::Cancelled
   /// Replaces the ICP run inside each search evaluation, for baselines that
-  /// measure another ICP implementation against the same search: aligns
+  /// measure another ICP implementation against the same search (called from
+  /// config.threads threads at once, so it must be thread-safe): aligns
   /// `source` onto `target` from `initial` and returns T_target_source. Empty:
   /// core's point-to-point ICP against the prebuilt target index.
   std::function<Transform(const Points& source, const Points& target, const Transform& initial)>

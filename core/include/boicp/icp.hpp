@@ -1,6 +1,8 @@
 #pragma once
 // Point-to-point ICP (Besl & McKay) against a prebuilt target index.
 
+#include <limits>
+
 #include "boicp/nearest_neighbors.hpp"
 #include "boicp/types.hpp"
 
@@ -12,6 +14,17 @@ struct IcpOptions {
   double convergence_translation = 1e-4;  // metres: stop once a step moves less than this...
   double convergence_rotation = 1e-4;     // ...and rotates less than this (radians)
   int threads = 1;  // for the nearest-neighbour searches; results do not depend on it
+
+  // Abandoning runs that cannot win. When abandon_above is finite, every
+  // iteration also measures the truncated mean distance (each point's
+  // distance clipped at `truncation` metres, which must not exceed the gate)
+  // and the run stops once even the limit projected from its recent progress
+  // stays above abandon_above (see ProjectedLimit). The refinement gives up
+  // on candidates that head for a worse fit than its leader this way, long
+  // before they converge.
+  double abandon_above = std::numeric_limits<double>::infinity();  // metres
+  double truncation = 0.0;                                         // metres
+  int abandon_after = 5;  // iterations always run before a run may be abandoned
 };
 
 /// Outcome of one ICP run. `transform` is T_target_source: p_target = T * p_source.
@@ -21,6 +34,7 @@ struct IcpResult {
   bool converged = false;      // the step criterion was met before max_iterations
   size_t correspondences = 0;  // in the last iteration
   double rmse = 0.0;           // of the last iteration's correspondences, metres
+  bool abandoned = false;      // stopped because it could not beat options.abandon_above
 };
 
 /// Rigid transform that best maps the `source` points onto their paired
@@ -28,6 +42,13 @@ struct IcpResult {
 /// from the sums of one iteration. Precondition: count >= 3, not collinear.
 Transform RigidFromCrossCovariance(const Point& source_mean, const Point& target_mean,
                                    const Eigen::Matrix3d& cross_covariance);
+
+/// The lowest value a decreasing sequence can reach in `remaining_steps` more
+/// steps if no step falls faster than the faster of its last two, from its
+/// last three values (oldest first): f2 - max(f0 - f1, f1 - f2, 0) * remaining.
+/// ICP slides into a basin at a roughly steady or slowing pace, so a run whose
+/// bound stays above the incumbent is not going to beat it.
+double ProjectedLimit(double f0, double f1, double f2, int remaining_steps);
 
 /// Runs ICP from `initial`. Allocates its scratch buffers once per call, never
 /// per iteration. With fewer than 3 correspondences it stops and returns the

@@ -23,6 +23,14 @@ class NearestNeighborIndex {
   bool Nearest(const Point& query, double max_squared_distance, size_t& index,
                double& squared_distance) const;
 
+  /// The same, given a target point `hint` (an index into points()) known to
+  /// be close, such as the previous ICP iteration's match: its distance
+  /// bounds the search from the start, so far fewer tree cells are visited.
+  /// Same answer as Nearest except that among points at exactly the hint's
+  /// distance the hint is returned. Precondition: hint < size().
+  bool NearestWithHint(const Point& query, size_t hint, double max_squared_distance, size_t& index,
+                       double& squared_distance) const;
+
   const Points& points() const;
   size_t size() const { return points().size(); }
 

@@ -21,7 +21,8 @@ namespace boicp {
 Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which);
 
 /// ICP settings of one search evaluation: the config's correspondence gate and
-/// iteration cap, converging once a step moves less than 1e-3 voxel.
+/// iteration cap, converging once a step moves less than 1e-2 voxel and turns
+/// less than 1e-3 rad.
 IcpOptions SearchIcpOptions(const BoIcpConfig& config);
 
 /// One level of the refinement pyramid.
@@ -51,9 +52,14 @@ struct RefinedAlignment {
   AlignmentScore score;
 };
 
-/// Coarse-to-fine point-to-point ICP from `start`: the search clouds with a
-/// 1.5 voxel gate, then each pyramid level with a gate of 3 of its voxels.
-RefinedAlignment RefineCoarseToFine(const Transform& start, const PreparedPair& pair,
+/// Coarse-to-fine point-to-point ICP from each of `starts` (T_target_source,
+/// best guess first; at least one): the search clouds with a 1.5 voxel gate,
+/// then each pyramid level with a gate of 3 of its voxels. Returns the start
+/// that fits best at the finest level. At every level the leader (the best fit
+/// so far) runs first; the others are abandoned as soon as they cannot beat
+/// its truncated mean distance (clipped at 1.5 voxels of the level), so a
+/// start in a wrong basin costs a few coarse iterations instead of a full run.
+RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const PreparedPair& pair,
                                     const BoIcpConfig& config);
 
 }  // namespace boicp
