@@ -9,6 +9,7 @@
 
 #include <nlopt.hpp>
 
+#include "boicp/parallel_for.hpp"
 #include "boicp/sampling.hpp"
 #include "boicp/types.hpp"
 
@@ -16,6 +17,7 @@ namespace boicp {
 namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
+constexpr Eigen::Index kScoringBlock = 250;  // candidates per block of GP predictions
 constexpr double kInvSqrt2Pi = 0.39894228040143267794;
 
 // erfc keeps full relative accuracy in the lower tail, where EI lives.
@@ -118,26 +120,42 @@ double ProbabilityOfImprovement(double mean, double std, double best, double xi)
 // xi is applied in the GP's standardised output scale, i.e. as
 // options.xi * gp.output_scale() in the caller's units.
 Eigen::VectorXd MaximiseExpectedImprovement(const GaussianProcess& gp, double best,
-                                            const AcquisitionOptions& options,
-                                            std::mt19937_64& rng) {
+                                            const AcquisitionOptions& options, std::mt19937_64& rng,
+                                            int threads) {
   CheckAcquisitionOptions(options);
   const int d = gp.dimension();
   const StandardisedEi ei{&gp, (best - gp.output_mean()) / gp.output_scale(), options.xi};
 
+  // Scored in blocks of a fixed size, so the rounding (and the answer) is the
+  // same for any thread count.
   const Eigen::MatrixXd candidates = UniformPoints(options.random_candidates, d, rng);
-  Eigen::VectorXd mean, std;
-  gp.PredictBatch(candidates, mean, std);
   Eigen::VectorXd score(candidates.rows());
-  for (Eigen::Index i = 0; i < score.size(); ++i) score(i) = ei(mean(i), std(i));
+  const Eigen::Index rows = candidates.rows();
+  const auto blocks = static_cast<size_t>((rows + kScoringBlock - 1) / kScoringBlock);
+  ParallelFor(blocks, threads, [&](size_t b) {
+    const Eigen::Index first = static_cast<Eigen::Index>(b) * kScoringBlock;
+    const Eigen::Index count = std::min(kScoringBlock, rows - first);
+    Eigen::VectorXd mean, std;
+    gp.PredictBatch(candidates.middleRows(first, count), mean, std);
+    for (Eigen::Index i = 0; i < count; ++i) score(first + i) = ei(mean(i), std(i));
+  });
 
+  // Each local refinement keeps its own best; the first of equal bests wins.
   const std::vector<Eigen::Index> top = TopIndices(score, std::max(options.local_starts, 1));
-  LocalSearch search{ei, Eigen::VectorXd(d), candidates.row(top.front()).transpose(),
-                     score(top.front())};
-  for (int s = 0; s < options.local_starts && s < static_cast<int>(top.size()); ++s) {
-    RefineWithBobyqa(candidates.row(top[static_cast<size_t>(s)]).transpose(),
-                     options.local_max_evaluations, search);
+  const size_t starts =
+      std::min(static_cast<size_t>(std::max(options.local_starts, 0)), top.size());
+  std::vector<LocalSearch> searches;
+  for (size_t s = 0; s < std::max<size_t>(starts, 1); ++s) {
+    searches.push_back({ei, Eigen::VectorXd(d), candidates.row(top[s]).transpose(), score(top[s])});
   }
-  return search.best_x.cwiseMax(0.0).cwiseMin(1.0);
+  ParallelFor(starts, threads, [&](size_t s) {
+    RefineWithBobyqa(candidates.row(top[s]).transpose(), options.local_max_evaluations,
+                     searches[s]);
+  });
+  const LocalSearch& winner = *std::max_element(
+      searches.begin(), searches.end(),
+      [](const LocalSearch& a, const LocalSearch& b) { return a.best_value < b.best_value; });
+  return winner.best_x.cwiseMax(0.0).cwiseMin(1.0);
 }
 
 // As for EI, xi is in standard deviations of the observed outputs.

@@ -155,14 +155,14 @@ void UpdateSurrogate(GaussianProcess& gp, const std::vector<BayesOptSample>& his
 // it so the next proposal goes elsewhere. q = 1 is plain expected improvement.
 std::vector<Eigen::VectorXd> ProposeRound(GaussianProcess gp,
                                           const std::vector<BayesOptSample>& history, double best,
-                                          int q, const AcquisitionOptions& acquisition,
+                                          int q, const AcquisitionOptions& acquisition, int threads,
                                           std::mt19937_64& rng) {
   Eigen::MatrixXd X;
   Eigen::VectorXd y;
   HistoryAsData(history, gp.dimension(), X, y);
   std::vector<Eigen::VectorXd> proposals;
   for (int j = 0; j < q; ++j) {
-    proposals.push_back(MaximiseExpectedImprovement(gp, best, acquisition, rng));
+    proposals.push_back(MaximiseExpectedImprovement(gp, best, acquisition, rng, threads));
     if (j + 1 == q) break;
     const double believed = gp.Predict(proposals.back()).mean;
     X.conservativeResize(X.rows() + 1, Eigen::NoChange);
@@ -211,8 +211,8 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
     if (refit) since_fit = 0;
     fitted = gp.hyperparameters();
     have_fit = true;
-    evaluator.EvaluateRound(
-        ProposeRound(gp, result.history, result.best_y, round, options.acquisition, rng));
+    evaluator.EvaluateRound(ProposeRound(gp, result.history, result.best_y, round,
+                                         options.acquisition, options.threads, rng));
     done += round;
     since_fit += round;
   }

@@ -102,6 +102,25 @@ TEST(AcquisitionTest, MaximiserStaysInsideTheBox) {
   }
 }
 
+TEST(AcquisitionTest, ThreadCountDoesNotChangeTheMaximiser) {
+  std::mt19937_64 data_rng(6);
+  const Eigen::MatrixXd X = LatinHypercube(20, 3, data_rng);
+  Eigen::VectorXd y(X.rows());
+  for (Eigen::Index i = 0; i < X.rows(); ++i) y(i) = std::sin(6.0 * X(i, 0)) + X(i, 1) * X(i, 2);
+  GaussianProcess gp({false, true, false});
+  gp.Fit(X, y, GpFitOptions{}, data_rng);
+  AcquisitionOptions options;
+  options.random_candidates = 1111;  // not a multiple of the scoring block
+  for (int threads : {2, 3}) {
+    std::mt19937_64 serial_rng(21), parallel_rng(21);
+    const Eigen::VectorXd serial =
+        MaximiseExpectedImprovement(gp, y.minCoeff(), options, serial_rng);
+    const Eigen::VectorXd parallel =
+        MaximiseExpectedImprovement(gp, y.minCoeff(), options, parallel_rng, threads);
+    EXPECT_TRUE(serial == parallel) << serial.transpose() << " vs " << parallel.transpose();
+  }
+}
+
 TEST(AcquisitionTest, MaxProbabilityOfImprovementIsAProbability) {
   const GaussianProcess gp = QuadraticOnLine();
   std::mt19937_64 rng(2);

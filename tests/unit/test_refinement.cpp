@@ -27,27 +27,36 @@ TEST(Refinement, PyramidHalvesFromTheSearchVoxelDownToTheRefineVoxel) {
   EXPECT_LT(pair.pyramid[0].source.size(), pair.pyramid[2].source.size());
 }
 
-TEST(Refinement, RecoversATransformFromAStartInsideTheBasin) {
-  const Points world = MakeSyntheticStreet(7, 30.0);
-  const Transform truth = PoseFromYawTranslation(0.05, {0.4, -0.3, 0.0});
-  const Points target = SimulateScan(world, Transform::Identity(), 40.0, 0.0, 1);
-  const Points source = TransformPoints(truth.inverse(), target);
-  const BoIcpConfig config = StreetConfig();
-  const PreparedPair pair = PreparePair(source, target, config);
+// A street scan and the same scan moved by `truth`^-1, so T_target_source = truth.
+struct KnownPair {
+  Transform truth;
+  BoIcpConfig config;
+  PreparedPair pair;
+};
 
-  const RefinedAlignment refined = RefineCoarseToFine({Transform::Identity()}, pair, config);
+KnownPair MakeKnownPair() {
+  const Transform truth = PoseFromYawTranslation(0.05, {0.4, -0.3, 0.0});
+  const BoIcpConfig config = StreetConfig();
+  const Points target =
+      SimulateScan(MakeSyntheticStreet(7, 30.0), Transform::Identity(), 40.0, 0.0, 1);
+  return {truth, config, PreparePair(TransformPoints(truth.inverse(), target), target, config)};
+}
+
+TEST(Refinement, RecoversATransformFromAStartInsideTheBasin) {
+  const KnownPair known = MakeKnownPair();
+  const Transform& truth = known.truth;
+  const RefinedAlignment refined =
+      RefineCoarseToFine({Transform::Identity()}, known.pair, known.config);
   EXPECT_LT(RotationAngle(refined.transform.inverse() * truth), 1e-3);
   EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
   EXPECT_GT(refined.score.fitness, 0.99);
 }
 
 TEST(Refinement, TheStartThatFitsBestWinsWhateverItsPlaceInTheList) {
-  const Points world = MakeSyntheticStreet(7, 30.0);
-  const Transform truth = PoseFromYawTranslation(0.05, {0.4, -0.3, 0.0});
-  const Points target = SimulateScan(world, Transform::Identity(), 40.0, 0.0, 1);
-  const Points source = TransformPoints(truth.inverse(), target);
-  const BoIcpConfig config = StreetConfig();
-  const PreparedPair pair = PreparePair(source, target, config);
+  const KnownPair known = MakeKnownPair();
+  const Transform& truth = known.truth;
+  const PreparedPair& pair = known.pair;
+  const BoIcpConfig& config = known.config;
   const Transform wrong = PoseFromYawTranslation(M_PI, {3.0, 1.0, 0.0});  // another basin
 
   for (const std::vector<Transform>& starts :

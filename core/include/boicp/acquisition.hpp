@@ -29,10 +29,11 @@ struct AcquisitionOptions {
 /// EI is evaluated in the GP's standardised output scale, so options.xi acts as
 /// options.xi * gp.output_scale() in the caller's units. Scores
 /// options.random_candidates uniform points, then refines the best
-/// options.local_starts of them with NLopt LN_BOBYQA.
+/// options.local_starts of them with NLopt LN_BOBYQA. Both steps use up to
+/// `threads` threads; the answer does not depend on it.
 Eigen::VectorXd MaximiseExpectedImprovement(const GaussianProcess& gp, double best,
-                                            const AcquisitionOptions& options,
-                                            std::mt19937_64& rng);
+                                            const AcquisitionOptions& options, std::mt19937_64& rng,
+                                            int threads = 1);
 
 /// Largest probability of improvement over `best` among `candidates` uniform
 /// points: how likely the surrogate thinks it is that an unexplored point beats

@@ -17,14 +17,17 @@ namespace boicp {
 struct BayesOptOptions {
   int initial_samples = 10;  // N_r: Latin-hypercube samples before the GP guides the search
   int iterations = 20;       // N: expected-improvement steps after the initial samples
-  // Evaluations between fits of the GP hyperparameters; in between, the GP is
-  // only conditioned on the new data with the hyperparameters held.
+  // Evaluations between refits of the GP hyperparameters (one L-BFGS run from
+  // the previous values); in between, the GP is only conditioned on the new
+  // data with the hyperparameters held.
   int refit_every = 5;
   // q: points proposed per round (kriging believer: each proposal is added to
   // the GP at its predicted mean before the next is chosen) and evaluated
   // together. The answer depends on q, never on `threads`.
   int batch_size = 2;
-  int threads = 1;  // evaluations of one round run at once (the objective must be thread-safe)
+  // Evaluations of one round run at once (the objective must be thread-safe),
+  // and the acquisition scores its candidates on as many threads.
+  int threads = 1;
   GpFitOptions fit;
   AcquisitionOptions acquisition;
   int confidence_candidates = 2000;  // points scanned for MaxProbabilityOfImprovement at the end
@@ -65,14 +68,14 @@ using BayesOptProgress = std::function<void(int done, int total, double best_y)>
 /// f must return finite values.
 ///
 /// Details: if initial_points.size() >= initial_samples only the initial
-/// points are used; each is clamped into the box. Before an EI round the GP
-/// hyperparameters are fitted with options.fit (warm start + restarts) when
-/// refit_every evaluations have come in since the last fit, and held
-/// otherwise. progress is called after every evaluation, in proposal order. Invalid options,
-/// malformed initial points and non-finite objective values (the message names
-/// the 0-based evaluation index) throw boicp::InputError. One
-/// std::mt19937_64(seed) drives every random choice, so a seed reproduces the
-/// run bit for bit.
+/// points are used; each is clamped into the box. The first and the final GP
+/// fit use options.fit (warm start + restarts). Before an EI round the
+/// hyperparameters are refitted by one L-BFGS run from the previous ones when
+/// refit_every evaluations have come in since the last fit, and held (the GP
+/// only conditioned on the new data) otherwise. progress is called after every evaluation, in
+/// proposal order. Invalid options, malformed initial points and non-finite objective values (the
+/// message names the 0-based evaluation index) throw boicp::InputError. One std::mt19937_64(seed)
+/// drives every random choice, so a seed reproduces the run bit for bit.
 BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points = {},
