@@ -7,6 +7,8 @@
 #include <grpcpp/server_builder.h>
 #include <spdlog/spdlog.h>
 
+#include "storage_check.hpp"
+
 namespace boicp::server {
 namespace {
 
@@ -21,6 +23,8 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   auto credentials = MakeServerCredentials(options_.tls_cert, options_.tls_key);
 
   data_dir_ = std::make_unique<DataDir>(options_.data_dir);
+  const uint64_t min_free_bytes = options_.min_free_mb << 20;
+  RequireStorage(*data_dir_, min_free_bytes);
   store_ = std::make_unique<JobStore>(data_dir_->DatabasePath());
   watches_ = std::make_unique<WatchHub>();
   ManagerOptions manager_options;
@@ -29,9 +33,12 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_options.registration_threads = options_.registration_threads;
   manager_options.max_queued_jobs = options_.max_queued_jobs;
   manager_options.max_batch_scans = options_.max_batch_scans;
+  manager_options.max_scan_points = options_.max_scan_points;
+  manager_options.min_free_bytes = min_free_bytes;
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   service_ = std::make_unique<MapBuilderService>(
-      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, options_.max_scan_bytes});
+      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, options_.max_scan_bytes,
+                  options_.max_scan_points, min_free_bytes});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -56,6 +63,11 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   spdlog::info("boicpd {} workers x {} registration threads, {} concurrent jobs, data in {}",
                options_.workers, options_.registration_threads, options_.concurrent_jobs,
                data_dir_->root());
+  spdlog::info(
+      "limits: {} queued jobs, {} scans a batch, {} bytes a message, {} bytes and {} "
+      "points a scan; {} MiB kept free",
+      options_.max_queued_jobs, options_.max_batch_scans, options_.max_message_bytes,
+      options_.max_scan_bytes, options_.max_scan_points, options_.min_free_mb);
   spdlog::info("auth {}, TLS {}", auth_.enabled() ? "on" : "off",
                options_.tls_cert.empty() ? "off" : "on");
   spdlog::info("listening on {}", address_);

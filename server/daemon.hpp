@@ -21,7 +21,7 @@ class Daemon {
  public:
   /// Opens the data directory, resumes unfinished jobs and starts serving.
   /// Throws std::runtime_error when any of that fails (port taken, data
-  /// directory locked, unreadable TLS files).
+  /// directory locked, unwritable or below --min-free-mb, unreadable TLS files).
   explicit Daemon(const DaemonOptions& options);
   /// Shuts down if Shutdown() was not called.
   ~Daemon();

@@ -41,6 +41,15 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
   app.add_option("--max-scan-bytes", o.max_scan_bytes, "Largest scan accepted by UploadScan")
       ->capture_default_str()
       ->envname("BOICPD_MAX_SCAN_BYTES");
+  app.add_option("--max-scan-points", o.max_scan_points,
+                 "Most points one scan may decode to (checked at upload and submission)")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_SCAN_POINTS");
+  app.add_option("--min-free-mb", o.min_free_mb,
+                 "MiB kept free in the data directory: below it boicpd does not start and "
+                 "refuses new scans and batches (0 = only a full disk)")
+      ->capture_default_str()
+      ->envname("BOICPD_MIN_FREE_MB");
   app.add_option("--auth-token-file", o.auth_token_file,
                  "Require 'authorization: Bearer <token>' with the token in this file")
       ->envname("BOICPD_AUTH_TOKEN_FILE");
@@ -69,6 +78,8 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.max_batch_scans >= 2, "--max-batch-scans must be at least 2");
   require(o.max_message_bytes >= 1024, "--max-message-bytes must be at least 1024");
   require(o.max_scan_bytes >= 16, "--max-scan-bytes must be at least 16");
+  require(o.max_scan_points >= 1, "--max-scan-points must be at least 1");
+  require(o.min_free_mb <= (uint64_t{1} << 40), "--min-free-mb must be at most 2^40");
   require(o.shutdown_grace_s >= 0.0, "--shutdown-grace must be >= 0");
   require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "critical"};

@@ -18,6 +18,8 @@ struct DaemonOptions {
   int max_batch_scans = 100000;
   int max_message_bytes = 4 << 20;         // gRPC receive limit per message
   uint64_t max_scan_bytes = 256ull << 20;  // per uploaded scan
+  uint64_t max_scan_points = 5000000;      // per scan, after decoding (about 20 128-beam sweeps)
+  uint64_t min_free_mb = 1024;  // MiB kept free in the data directory; new work is refused below
   std::string auth_token_file;
   std::string tls_cert, tls_key;
   double shutdown_grace_s = 5.0;  // how long SIGTERM waits for open calls

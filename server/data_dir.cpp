@@ -9,36 +9,56 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "boicp/types.hpp"
+#include "sha256.hpp"
+#include "storage_errors.hpp"
+
 namespace boicp::server {
 namespace fs = std::filesystem;
 namespace {
 
 void FsyncPath(const std::string& path, int flags) {
   const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
-  if (fd < 0) throw std::runtime_error(path + ": cannot open (" + std::strerror(errno) + ")");
+  if (fd < 0) throw StorageError(path + ": cannot open (" + std::strerror(errno) + ")");
   const int rc = ::fsync(fd);
   const int error = errno;
   ::close(fd);
-  if (rc != 0) throw std::runtime_error(path + ": fsync failed (" + std::strerror(error) + ")");
+  if (rc != 0) throw StorageError(path + ": fsync failed (" + std::strerror(error) + ")");
 }
+
+constexpr const char* kSubdirs[] = {"scans", "jobs", "tmp"};
 
 }  // namespace
 
 DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_normal().string()) {
-  for (const char* sub : {"scans", "jobs", "tmp"}) fs::create_directories(fs::path(root_) / sub);
+  for (const char* sub : kSubdirs) {
+    std::error_code error;
+    fs::create_directories(fs::path(root_) / sub, error);
+    if (error) {
+      throw StorageError("data directory " + root_ + ": cannot create " + sub + "/ (" +
+                         error.message() + ")");
+    }
+  }
   const std::string lock_path = (fs::path(root_) / "lock").string();
   lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (lock_fd_ < 0) {
-    throw std::runtime_error(lock_path + ": cannot open (" + std::strerror(errno) + ")");
+    throw StorageError("data directory " + root_ + ": cannot open its lock file (" +
+                       std::strerror(errno) + ")");
   }
   if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
     ::close(lock_fd_);
     throw std::runtime_error(root_ + ": another boicpd is using this data directory");
   }
   // Leftovers of uploads that were in flight when a daemon died.
-  for (const auto& entry : fs::directory_iterator(fs::path(root_) / "tmp")) {
+  std::error_code error;
+  for (fs::directory_iterator it(fs::path(root_) / "tmp", error), end; !error && it != end;
+       it.increment(error)) {
     std::error_code ignored;
-    fs::remove_all(entry.path(), ignored);
+    fs::remove_all(it->path(), ignored);
+  }
+  if (error) {
+    ::close(lock_fd_);
+    throw StorageError("data directory " + root_ + ": cannot read tmp/ (" + error.message() + ")");
   }
 }
 
@@ -49,16 +69,24 @@ DataDir::~DataDir() {
 std::string DataDir::DatabasePath() const { return (fs::path(root_) / "boicpd.sqlite").string(); }
 
 std::string DataDir::ScanPath(const std::string& scan_id) const {
+  if (!IsSha256Hex(scan_id)) throw InputError("'" + scan_id + "' is not a scan id");
   return (fs::path(root_) / "scans" / scan_id.substr(0, 2) / scan_id).string();
 }
 
 bool DataDir::HasScanFile(const std::string& scan_id) const {
+  if (!IsSha256Hex(scan_id)) return false;
   std::error_code ec;
   return fs::is_regular_file(ScanPath(scan_id), ec);
 }
 
 std::string DataDir::JobDir(const std::string& job_id) const {
   return (fs::path(root_) / "jobs" / job_id).string();
+}
+
+std::vector<std::string> DataDir::WritableDirs() const {
+  std::vector<std::string> dirs = {root_};
+  for (const char* sub : kSubdirs) dirs.push_back((fs::path(root_) / sub).string());
+  return dirs;
 }
 
 std::string DataDir::NewTempPath() {
@@ -69,9 +97,16 @@ std::string DataDir::NewTempPath() {
 
 void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) const {
   const fs::path target = ScanPath(scan_id);
-  fs::create_directories(target.parent_path());
-  FsyncPath(tmp_path, O_RDONLY);
-  fs::rename(tmp_path, target);
+  std::error_code error;
+  fs::create_directories(target.parent_path(), error);
+  if (!error) {
+    FsyncPath(tmp_path, O_RDONLY);
+    fs::rename(tmp_path, target, error);
+  }
+  if (error) {
+    throw StorageError("cannot store scan " + scan_id.substr(0, 12) + " in " + root_ + " (" +
+                       error.message() + ")");
+  }
   FsyncPath(target.parent_path().string(), O_RDONLY | O_DIRECTORY);
 }
 

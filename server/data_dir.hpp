@@ -9,13 +9,15 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace boicp::server {
 
 class DataDir {
  public:
-  /// Creates the layout and takes the lock. Throws std::runtime_error when
-  /// the directory cannot be created or another daemon holds it.
+  /// Creates the layout and takes the lock. Throws StorageError when the
+  /// directory cannot be created or opened, std::runtime_error when another
+  /// daemon holds it.
   explicit DataDir(const std::string& root);
   ~DataDir();
   DataDir(const DataDir&) = delete;
@@ -23,14 +25,21 @@ class DataDir {
 
   const std::string& root() const { return root_; }
   std::string DatabasePath() const;
+  /// Throws InputError unless `scan_id` is 64 lowercase hex digits, so that
+  /// no client string ever becomes a path outside scans/.
   std::string ScanPath(const std::string& scan_id) const;
+  /// False for an id that is not a scan id.
   bool HasScanFile(const std::string& scan_id) const;
   std::string JobDir(const std::string& job_id) const;
+  /// The directories the daemon creates files in: the root (database), scans/,
+  /// jobs/ and tmp/.
+  std::vector<std::string> WritableDirs() const;
 
   /// A fresh path under tmp/ for an upload in progress.
   std::string NewTempPath();
 
-  /// Flushes `tmp_path` to disk and renames it to ScanPath(scan_id).
+  /// Flushes `tmp_path` to disk and renames it to ScanPath(scan_id). Throws
+  /// StorageError when the disk refuses.
   void CommitScan(const std::string& tmp_path, const std::string& scan_id) const;
 
  private:

@@ -8,6 +8,7 @@
 #include "job_spec.hpp"
 #include "proto_convert.hpp"
 #include "service_error.hpp"
+#include "storage_check.hpp"
 
 namespace boicp::server {
 
@@ -64,10 +65,19 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
       throw InputError("scan_ids[" + std::to_string(i) + "]: unknown scan id '" +
                        request.scan_ids(i) + "' (upload it first)");
     }
+    // Scans stored under a higher limit, before a restart, meet the current one here.
+    if (scan->num_points > options_.max_scan_points) {
+      throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                         "scan_ids[" + std::to_string(i) +
+                             "]: " + std::to_string(scan->num_points) +
+                             " points is over this daemon's limit of " +
+                             std::to_string(options_.max_scan_points) + " (--max-scan-points)");
+    }
     input.scans.push_back(scan->metadata);
   }
   const JobSpec spec =
       BuildJobSpec("new", request, input.scans, data_dir_, options_.registration_threads);
+  RequireStorage(data_dir_, options_.min_free_bytes);
 
   std::lock_guard<std::mutex> lock(mutex_);
   if (!accepting_) {

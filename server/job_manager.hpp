@@ -25,11 +25,13 @@ namespace boicp::server {
 namespace v1 = ::boicp::v1;
 
 struct ManagerOptions {
-  int workers = 1;               // pool threads: pair registrations running at once
-  int concurrent_jobs = 1;       // jobs running at once (each also fuses its map on its slot)
-  int registration_threads = 1;  // threads inside one registration
-  int max_queued_jobs = 64;      // queued (not yet running) jobs; more is RESOURCE_EXHAUSTED
-  int max_batch_scans = 100000;  // scans per batch; more is RESOURCE_EXHAUSTED
+  int workers = 1;                     // pool threads: pair registrations running at once
+  int concurrent_jobs = 1;             // jobs running at once (each also fuses its map on its slot)
+  int registration_threads = 1;        // threads inside one registration
+  int max_queued_jobs = 64;            // queued (not yet running) jobs; more is RESOURCE_EXHAUSTED
+  int max_batch_scans = 100000;        // scans per batch; more is RESOURCE_EXHAUSTED
+  uint64_t max_scan_points = 5000000;  // points per stored scan; more is RESOURCE_EXHAUSTED
+  uint64_t min_free_bytes = 0;  // below it (or unwritable) new batches are FAILED_PRECONDITION
 };
 
 class JobManager {
@@ -47,7 +49,8 @@ class JobManager {
 
   /// Validates and queues a batch; returns the queued job. Throws
   /// InputError (bad batch), ServiceError RESOURCE_EXHAUSTED (limits) or
-  /// UNAVAILABLE (draining).
+  /// UNAVAILABLE (draining), StorageError (data directory unwritable or
+  /// below its reserve).
   v1::Job Submit(const v1::SubmitBatchRequest& request);
 
   /// Cancels a queued job at once, asks a running one to stop (its state

@@ -1,5 +1,7 @@
 #include "job_outputs.hpp"
 
+#include <filesystem>
+
 namespace boicp::server {
 
 std::optional<std::string> ExportFileName(int format) {
@@ -27,6 +29,17 @@ MapOutputPaths JobOutputPaths(const std::string& job_dir) {
   paths.trajectory_kitti = job_dir + "/trajectory.kitti";
   paths.cloud_ply = job_dir + "/map.ply";
   return paths;
+}
+
+void RemoveStagingFiles(const std::string& job_dir) {
+  std::error_code error;
+  for (std::filesystem::directory_iterator it(job_dir, error), end; !error && it != end;
+       it.increment(error)) {
+    if (it->path().extension() == ".tmp") {
+      std::error_code ignored;
+      std::filesystem::remove(it->path(), ignored);
+    }
+  }
 }
 
 }  // namespace boicp::server

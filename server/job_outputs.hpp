@@ -16,4 +16,9 @@ std::optional<std::string> ExportFileName(int format);
 /// Every output of a job, under `job_dir`.
 MapOutputPaths JobOutputPaths(const std::string& job_dir);
 
+/// Removes the staging files ("*.tmp") that a daemon killed while writing
+/// this job's outputs left in `job_dir`. Only one run of a job writes at a
+/// time, so every staging file found there is stale.
+void RemoveStagingFiles(const std::string& job_dir);
+
 }  // namespace boicp::server

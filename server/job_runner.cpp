@@ -15,6 +15,7 @@
 #include "job_spec.hpp"
 #include "pair_task.hpp"
 #include "proto_convert.hpp"
+#include "scan_integrity.hpp"
 
 namespace boicp::server {
 
@@ -79,6 +80,7 @@ class JobRun {
     spec_ = BuildJobSpec(job_.job_id(), input->request, input->scans, ctx_.data_dir,
                          ctx_.registration_threads);
     num_scans_ = static_cast<int>(spec_.scans.size());
+    VerifyScans();
     for (StoredPair& stored : ctx_.store.GetPairs(job_.job_id())) {
       results_[IndexOf(stored.result)] = std::move(stored);
     }
@@ -119,6 +121,13 @@ class JobRun {
                  job_.pairs_total());
   }
 
+  // A scan whose bytes no longer match its name fails the job (the error
+  // names it) rather than feeding a wrong cloud into the map.
+  void VerifyScans() const {
+    const std::set<std::string> unique(spec_.scan_ids.begin(), spec_.scan_ids.end());
+    for (const std::string& scan_id : unique) VerifyStoredScan(ctx_.data_dir, scan_id);
+  }
+
   std::string PairingName() const {
     switch (spec_.pairing) {
       case PairingMode::kConsecutive:
@@ -144,7 +153,10 @@ class JobRun {
         LaunchAvailable();
         lock.lock();
       }
-      if (in_flight_ == 0 && (PlanComplete() || control_.StopRequested() || !failure_.empty())) {
+      // A pair may have finished while the previous batch was absorbed: its
+      // completion waits in completions_ and must be absorbed before the end.
+      if (in_flight_ == 0 && completions_.empty() &&
+          (PlanComplete() || control_.StopRequested() || !failure_.empty())) {
         break;
       }
       control_.changed.wait_for(lock, kProgressInterval, [&] {
@@ -334,19 +346,26 @@ class JobRun {
 
     const std::string dir = ctx_.data_dir.JobDir(job_.job_id());
     std::filesystem::create_directories(dir);
+    RemoveStagingFiles(dir);
     SetStage("fusing", 0, static_cast<uint32_t>(num_scans_));
+    VerifyScans();  // fusion reads every scan again; the registrations took a while
     const auto fuse_start = Clock::now();
     AssemblyCallbacks callbacks;
     callbacks.stop_requested = [this] { return control_.StopRequested(); };
     callbacks.progress = [this, fuse_start](const AssemblyProgress& p) {
-      if (p.stage != job_.stage()) job_.set_stage(p.stage);
+      const bool new_stage = p.stage != job_.stage();
+      if (new_stage) job_.set_stage(p.stage);
       job_.set_stage_done(static_cast<uint32_t>(p.done));
       job_.set_stage_total(static_cast<uint32_t>(p.total));
       if (p.stage == "fusing" && p.done > 0) {
         const double elapsed = std::chrono::duration<double>(Clock::now() - fuse_start).count();
         job_.set_eta_seconds(elapsed / p.done * (p.total - p.done));
       }
-      MaybePublishProgress();
+      if (new_stage) {
+        Publish(nullptr);  // watchers see "writing" begin, not a second later
+      } else {
+        MaybePublishProgress();
+      }
     };
     const FusionSummary summary =
         FuseScans(spec_.scans, estimate.poses, spec_.map, JobOutputPaths(dir), callbacks);

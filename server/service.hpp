@@ -22,7 +22,9 @@ struct ServiceDeps {
   JobManager& manager;
   WatchHub& watches;
   const BearerAuth& auth;
-  uint64_t max_scan_bytes = 0;  // larger uploads are RESOURCE_EXHAUSTED
+  uint64_t max_scan_bytes = 0;   // larger uploads are RESOURCE_EXHAUSTED
+  uint64_t max_scan_points = 0;  // scans decoding to more points are RESOURCE_EXHAUSTED
+  uint64_t min_free_bytes = 0;   // below it uploads and batches are FAILED_PRECONDITION
 };
 
 /// The freshest view of a job: the newest published snapshot, else the store.

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "boicp/types.hpp"
+#include "storage_errors.hpp"
 
 namespace boicp::server {
 
@@ -13,6 +14,11 @@ grpc::Status StatusFromCurrentException(const char* rpc) {
     return grpc::Status(e.code(), e.what());
   } catch (const InputError& e) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const StorageError& e) {
+    spdlog::warn("{}: refused: {}", rpc, e.what());
+    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION, e.what());
+  } catch (const CorruptScanError& e) {
+    return grpc::Status(grpc::StatusCode::DATA_LOSS, e.what());
   } catch (const std::exception& e) {
     spdlog::error("{}: internal error: {}", rpc, e.what());
     return grpc::Status(grpc::StatusCode::INTERNAL, std::string("internal error: ") + e.what());

@@ -21,7 +21,8 @@ class ServiceError : public std::runtime_error {
 
 /// Converts the exception being handled (call only inside a catch block):
 /// ServiceError keeps its code, boicp::InputError becomes INVALID_ARGUMENT,
-/// anything else INTERNAL, logged with `rpc` so that a bug is visible.
+/// StorageError FAILED_PRECONDITION, CorruptScanError DATA_LOSS, anything
+/// else INTERNAL, logged with `rpc` so that a bug is visible.
 grpc::Status StatusFromCurrentException(const char* rpc);
 
 /// Runs `handler` and converts whatever it throws with StatusFromCurrentException.

@@ -4,11 +4,33 @@
 
 #include <stdexcept>
 
+#include "storage_errors.hpp"
+
 namespace boicp::server {
 namespace {
 
+// Result codes that mean the disk, not the statement, is the problem.
+bool IsStorageFailure(int code) {
+  switch (code & 0xff) {
+    case SQLITE_FULL:
+    case SQLITE_READONLY:
+    case SQLITE_IOERR:
+    case SQLITE_CANTOPEN:
+    case SQLITE_PERM:
+      return true;
+    default:
+      return false;
+  }
+}
+
+[[noreturn]] void Throw(int code, const std::string& message) {
+  if (IsStorageFailure(code)) throw StorageError(message);
+  throw std::runtime_error(message);
+}
+
 [[noreturn]] void Fail(sqlite3* db, const std::string& what) {
-  throw std::runtime_error("sqlite: " + what + ": " + (db ? sqlite3_errmsg(db) : "out of memory"));
+  if (db == nullptr) throw std::runtime_error("sqlite: " + what + ": out of memory");
+  Throw(sqlite3_extended_errcode(db), "sqlite: " + what + ": " + sqlite3_errmsg(db));
 }
 
 }  // namespace
@@ -86,10 +108,10 @@ std::string SqliteStatement::ColumnBlob(int column) const {
 SqliteDatabase::SqliteDatabase(const std::string& path) {
   // FULLMUTEX: the connection may be used from several threads, one at a time.
   const int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX;
-  if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+  if (const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr); rc != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
-    throw std::runtime_error("sqlite: cannot open " + path + ": " + message);
+    Throw(rc, "sqlite: cannot open " + path + ": " + message);
   }
   sqlite3_busy_timeout(db_, 5000);
 }
@@ -98,10 +120,10 @@ SqliteDatabase::~SqliteDatabase() { sqlite3_close(db_); }
 
 void SqliteDatabase::Exec(const std::string& sql) {
   char* error = nullptr;
-  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
+  if (const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error); rc != SQLITE_OK) {
     const std::string message = error ? error : "unknown error";
     sqlite3_free(error);
-    throw std::runtime_error("sqlite: " + message + " in '" + sql + "'");
+    Throw(rc, "sqlite: " + message + " in '" + sql + "'");
   }
 }
 

@@ -1,12 +1,17 @@
 #include "upload_reactor.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 #include <spdlog/spdlog.h>
 
 #include "proto_convert.hpp"
+#include "scan_integrity.hpp"
 #include "service.hpp"
 #include "service_error.hpp"
+#include "storage_check.hpp"
+#include "storage_errors.hpp"
 
 namespace boicp::server {
 namespace {
@@ -17,6 +22,15 @@ std::string WithoutPath(std::string message, const std::string& path) {
     message.replace(at, path.size(), "uploaded scan");
   }
   return message;
+}
+
+void RequirePointLimit(size_t points, uint64_t limit) {
+  if (points > limit) {
+    throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                       "scan has " + std::to_string(points) +
+                           " points, over this daemon's limit of " + std::to_string(limit) +
+                           " (--max-scan-points)");
+  }
 }
 
 }  // namespace
@@ -75,7 +89,7 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
   if (metadata_) throw InputError("metadata may only be sent once, first");
   ValidateScanMetadata(metadata);
   known_ = !metadata.sha256().empty() && deps_.store.GetScan(metadata.sha256()) &&
-           deps_.data_dir.HasScanFile(metadata.sha256());
+           deps_.data_dir.HasScanFile(metadata.sha256()) && StoredCopyIntact(metadata.sha256());
   if (!known_) {
     if (metadata.size_bytes() == 0) {
       throw InputError("metadata.size_bytes is required (the number of bytes that follow)");
@@ -86,11 +100,26 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
                              " bytes is over this daemon's limit of " +
                              std::to_string(deps_.max_scan_bytes) + " (--max-scan-bytes)");
     }
+  }
+  RequireStorage(deps_.data_dir, deps_.min_free_bytes, known_ ? 0 : metadata.size_bytes());
+  if (!known_) {
     temp_path_ = deps_.data_dir.NewTempPath();
     temp_.open(temp_path_, std::ios::binary | std::ios::trunc);
-    if (!temp_) throw std::runtime_error(temp_path_ + ": cannot create");
+    if (!temp_) {
+      throw StorageError("cannot create " + temp_path_ + " (" + std::strerror(errno) + ")");
+    }
   }
   metadata_ = metadata;
+}
+
+bool UploadReactor::StoredCopyIntact(const std::string& scan_id) {
+  try {
+    VerifyStoredScan(deps_.data_dir, scan_id);
+    return true;
+  } catch (const CorruptScanError& e) {
+    corruption_ = e.what();  // the stored copy is gone; the bytes must come again
+    return false;
+  }
 }
 
 void UploadReactor::AcceptChunk(const std::string& bytes) {
@@ -101,7 +130,9 @@ void UploadReactor::AcceptChunk(const std::string& bytes) {
                      std::to_string(metadata_->size_bytes()) + ")");
   }
   temp_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!temp_) throw std::runtime_error(temp_path_ + ": write failed");
+  if (!temp_) {
+    throw StorageError("writing " + temp_path_ + " failed (" + std::strerror(errno) + ")");
+  }
   hash_.Update(bytes.data(), bytes.size());
   received_ += bytes.size();
 }
@@ -119,6 +150,7 @@ void UploadReactor::Complete() {
     } catch (const InputError& e) {
       throw InputError(WithoutPath(e.what(), path));
     }
+    RequirePointLimit(cloud.points.size(), deps_.max_scan_points);
     metadata.set_size_bytes(deps_.store.GetScan(metadata.sha256())->metadata.size_bytes());
     deps_.store.PutScan(metadata, cloud.points.size());
     response_->set_scan_id(metadata.sha256());
@@ -128,12 +160,17 @@ void UploadReactor::Complete() {
     spdlog::info("scan {} already stored; metadata updated", metadata.sha256().substr(0, 12));
     return;
   }
+  if (received_ == 0 && !corruption_.empty()) {
+    throw ServiceError(grpc::StatusCode::DATA_LOSS, corruption_ + "; send the bytes with it");
+  }
   if (received_ != metadata.size_bytes()) {
     throw InputError("received " + std::to_string(received_) + " bytes, metadata.size_bytes says " +
                      std::to_string(metadata.size_bytes()));
   }
   temp_.close();
-  if (!temp_) throw std::runtime_error(temp_path_ + ": write failed");
+  if (!temp_) {
+    throw StorageError("writing " + temp_path_ + " failed (" + std::strerror(errno) + ")");
+  }
   const std::string id = hash_.HexDigest();
   if (!metadata.sha256().empty() && metadata.sha256() != id) {
     throw InputError("metadata.sha256 does not match the bytes received (got " + id + ")");
@@ -144,6 +181,7 @@ void UploadReactor::Complete() {
   } catch (const InputError& e) {
     throw InputError(WithoutPath(e.what(), temp_path_));
   }
+  RequirePointLimit(cloud.points.size(), deps_.max_scan_points);
   const bool present = deps_.data_dir.HasScanFile(id);
   if (!present) {
     deps_.data_dir.CommitScan(temp_path_, id);

@@ -2,7 +2,8 @@
 // UploadScan: metadata first, then the bytes in chunks, written to a temp
 // file and hashed as they arrive. At the end the scan is parsed with the
 // core loaders (so a malformed scan is refused at upload, not mid-batch),
-// then renamed to its hash and recorded.
+// then renamed to its hash and recorded. Refused (FAILED_PRECONDITION) while
+// the data directory cannot take the announced bytes.
 
 #include <fstream>
 #include <optional>
@@ -31,12 +32,16 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   void AcceptMetadata(const ::boicp::v1::ScanMetadata& metadata);
   void AcceptChunk(const std::string& bytes);
   void Complete();
+  /// Verifies the stored copy a client wants to reuse; false (and the reason
+  /// in corruption_) when it failed its hash check.
+  bool StoredCopyIntact(const std::string& scan_id);
 
   const ServiceDeps& deps_;
   ::boicp::v1::UploadScanResponse* response_;
   ::boicp::v1::UploadScanRequest request_;
   std::optional<::boicp::v1::ScanMetadata> metadata_;
-  bool known_ = false;  // the client named a hash the store holds: bytes are not needed
+  bool known_ = false;      // the client named a hash the store holds: bytes are not needed
+  std::string corruption_;  // the stored copy of the named hash failed its check
   std::string temp_path_;
   std::ofstream temp_;
   Sha256 hash_;

@@ -2,6 +2,8 @@
 
 #include <fstream>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "sha256.hpp"
 
@@ -71,19 +73,28 @@ v1::UploadScanResponse MapBuilderClient::Upload(const std::string& bytes, v1::Sc
     Check("FindScans", stub_->FindScans(&context, request, &response));
     present = response.missing_size() == 0;
   }
-  grpc::ClientContext context;
-  Authorize(context);
-  v1::UploadScanResponse response;
-  auto writer = stub_->UploadScan(&context, &response);
-  v1::UploadScanRequest message;
-  *message.mutable_metadata() = metadata;
-  bool open = writer->Write(message);
-  for (size_t at = 0; open && !present && at < bytes.size(); at += chunk_bytes) {
-    message.set_chunk(bytes.substr(at, chunk_bytes));
-    open = writer->Write(message);
+  auto send = [&](bool with_bytes) {
+    grpc::ClientContext context;
+    Authorize(context);
+    v1::UploadScanResponse response;
+    auto writer = stub_->UploadScan(&context, &response);
+    v1::UploadScanRequest message;
+    *message.mutable_metadata() = metadata;
+    bool open = writer->Write(message);
+    for (size_t at = 0; open && with_bytes && at < bytes.size(); at += chunk_bytes) {
+      message.set_chunk(bytes.substr(at, chunk_bytes));
+      open = writer->Write(message);
+    }
+    writer->WritesDone();
+    const grpc::Status status = writer->Finish();
+    return std::make_pair(status, response);
+  };
+  auto [status, response] = send(!present);
+  // The daemon's copy failed its hash check and was set aside: send the bytes.
+  if (present && status.error_code() == grpc::StatusCode::DATA_LOSS) {
+    std::tie(status, response) = send(true);
   }
-  writer->WritesDone();
-  Check("UploadScan", writer->Finish());
+  Check("UploadScan", status);
   return response;
 }
 

@@ -55,7 +55,8 @@ class MapBuilderClient {
   void set_unary_timeout(std::chrono::milliseconds timeout) { unary_timeout_ = timeout; }
 
   /// Uploads a scan; when the daemon already holds these bytes only the
-  /// metadata is sent. metadata.size_bytes and sha256 are filled in here.
+  /// metadata is sent (and the bytes after all if its copy turns out
+  /// corrupted). metadata.size_bytes and sha256 are filled in here.
   v1::UploadScanResponse Upload(const std::string& bytes, v1::ScanMetadata metadata,
                                 size_t chunk_bytes = 1 << 20);
   /// Reads the file and uploads it. Throws std::runtime_error when unreadable.

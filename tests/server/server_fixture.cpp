@@ -27,12 +27,49 @@ v1::SubmitBatchRequest QuickBatch(const std::vector<std::string>& scan_ids, uint
   return request;
 }
 
+grpc::Status RawUpload(client::MapBuilderClient& client, const v1::ScanMetadata& metadata,
+                       const std::vector<std::string>& chunks, const std::string& token) {
+  grpc::ClientContext context;
+  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+  v1::UploadScanResponse response;
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = metadata;
+  bool open = writer->Write(message);
+  for (const std::string& chunk : chunks) {
+    if (!open) break;
+    message.set_chunk(chunk);
+    open = writer->Write(message);
+  }
+  writer->WritesDone();
+  return writer->Finish();
+}
+
+v1::ScanMetadata Meta(v1::ScanFormat format, size_t size) {
+  v1::ScanMetadata metadata;
+  metadata.set_format(format);
+  metadata.set_size_bytes(size);
+  return metadata;
+}
+
+std::vector<std::string> MissingScans(client::MapBuilderClient& client,
+                                      const std::vector<std::string>& ids) {
+  grpc::ClientContext context;
+  client.Authorize(context);
+  v1::FindScansRequest request;
+  for (const std::string& id : ids) request.add_scan_ids(id);
+  v1::FindScansResponse response;
+  EXPECT_TRUE(client.stub().FindScans(&context, request, &response).ok());
+  return {response.missing().begin(), response.missing().end()};
+}
+
 void ServerTest::SetUp() {
   dir_ = std::filesystem::temp_directory_path() /
          ("boicpd_test_" + std::to_string(::getpid()) + "_" +
           ::testing::UnitTest::GetInstance()->current_test_info()->name());
   std::filesystem::remove_all(dir_);
   std::filesystem::create_directories(dir_);
+  data_dir_ = dir_ / "data";
 }
 
 void ServerTest::TearDown() {
@@ -45,7 +82,7 @@ void ServerTest::TearDown() {
 
 void ServerTest::StartDaemon(const std::vector<std::string>& args) {
   daemon_.reset();
-  std::vector<std::string> all = {"--data-dir", (dir_ / "data").string()};
+  std::vector<std::string> all = {"--data-dir", data_dir_.string()};
   all.insert(all.end(), args.begin(), args.end());
   daemon_ = std::make_unique<DaemonProcess>(
       all, (dir_ / ("boicpd." + std::to_string(starts_++) + ".log")).string());

@@ -22,13 +22,41 @@ namespace v1 = ::boicp::v1;
 /// rotation bounds. The scans overlap so much that this is still exact.
 v1::SubmitBatchRequest QuickBatch(const std::vector<std::string>& scan_ids, uint64_t seed = 3);
 
+/// Uploads raw messages: `metadata`, then `chunks` (stopping at the first
+/// refused write). Returns the final status.
+grpc::Status RawUpload(client::MapBuilderClient& client, const v1::ScanMetadata& metadata,
+                       const std::vector<std::string>& chunks, const std::string& token = "");
+
+v1::ScanMetadata Meta(v1::ScanFormat format, size_t size);
+
+/// The ids among `ids` that FindScans reports missing.
+std::vector<std::string> MissingScans(client::MapBuilderClient& client,
+                                      const std::vector<std::string>& ids);
+
+/// How a client call ended: OK when it returned, else the RpcError's code and
+/// message (without the rpc name).
+template <typename Call>
+grpc::Status StatusOf(Call&& call) {
+  try {
+    call();
+  } catch (const client::RpcError& e) {
+    return grpc::Status(e.code(), e.detail());
+  }
+  return grpc::Status::OK;
+}
+
+template <typename Call>
+grpc::StatusCode CodeOf(Call&& call) {
+  return StatusOf(std::forward<Call>(call)).error_code();
+}
+
 class ServerTest : public ::testing::Test {
  protected:
   void SetUp() override;
   void TearDown() override;
 
-  /// Starts (or restarts) the daemon on the test's data directory with
-  /// `args` after --data-dir. Default workers: 2, one registration thread.
+  /// Starts (or restarts) the daemon on data_dir_ with `args` after
+  /// --data-dir. Default workers: 2, one registration thread.
   void StartDaemon(const std::vector<std::string>& args = {"--workers", "2"});
   void StopDaemon() { daemon_.reset(); }
 
@@ -44,6 +72,7 @@ class ServerTest : public ::testing::Test {
                   const std::function<bool(const v1::Job&)>& done, double timeout_s);
 
   std::filesystem::path dir_;
+  std::filesystem::path data_dir_;  // dir_/data unless a test points it elsewhere
   std::unique_ptr<DaemonProcess> daemon_;
   int starts_ = 0;
 };
