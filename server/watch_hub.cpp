@@ -41,9 +41,11 @@ class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
   }
 
   void Enqueue(const v1::JobEvent& event) {
-    // Progress snapshots without a pair result supersede each other, so a
-    // slow client gets the newest state instead of an ever longer backlog.
-    if (!pending.empty() && !pending.back().has_pair() && !event.has_pair()) {
+    // Progress snapshots without a pair result supersede each other within a
+    // stage, so a slow client gets the newest state instead of an ever longer
+    // backlog, yet still sees every stage begin.
+    if (!pending.empty() && !pending.back().has_pair() && !event.has_pair() &&
+        pending.back().job().stage() == event.job().stage()) {
       pending.back() = event;
     } else {
       pending.push_back(event);
