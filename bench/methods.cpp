@@ -41,7 +41,8 @@ std::vector<std::string> DescribeMethods(const std::vector<std::string>& names, 
     } else if (name == "naive") {
       line +=
           "core RegisterPair with preset C (as bo-C), but every search evaluation calls Open3D "
-          "RegistrationICP afresh (converts the clouds, rebuilds the target kd-tree)";
+          "RegistrationICP afresh (converts the clouds, rebuilds the target kd-tree, whole "
+          "search source), one proposal at a time, hyperparameters refitted every step";
     } else if (name == "icp-identity") {
       line += "point-to-point ICP from the identity, then the shared coarse-to-fine refinement";
     } else if (name == "pyramid") {

@@ -51,7 +51,7 @@ std::string DescribeScaling(bool quick) {
     iterations += (iterations.empty() ? "" : ", ") + std::to_string(n);
   }
   return "bo-C on the first pair; voxel x (" + voxels +
-         ") of the dataset's, with the preset's 3000-point evaluation subsample "
+         ") of the dataset's, with the default 2000-point evaluation subsample "
          "(scaling-voxel) and with every point (scaling-voxel-all); N = (" +
          iterations + ") per stage with N_r = " + (quick ? "10" : "30") + " (scaling-iterations)";
 }

@@ -140,7 +140,7 @@ void ScalingSection(std::ostringstream& out, const RunInfo& info,
     auto icp = [](const ResultRow& r) { return r.icp_s.value_or(NAN); };
     auto model = [](const ResultRow& r) { return r.model_s.value_or(NAN); };
     out << "- " << dataset << ": wall vs source points " << series("scaling-voxel", points, wall)
-        << " (3000-point evaluations), " << series("scaling-voxel-all", points, wall)
+        << " (2000-point evaluations), " << series("scaling-voxel-all", points, wall)
         << " (all points; icp s " << series("scaling-voxel-all", points, icp)
         << "); icp s vs evaluations " << series("scaling-iterations", evaluations, icp)
         << "; model s vs samples per stage " << series("scaling-iterations", samples, model)
@@ -156,7 +156,8 @@ std::string FormatRunConditions(const RunInfo& info) {
       << info.machine.cpu_model << ", load average at start " << info.machine.load_average
       << "; Open3D " << info.machine.open3d_version << "\n"
       << "- Thread budget: " << info.threads
-      << " for every method (BO-ICP's nearest-neighbour loops, the pyramid's grid scoring, and "
+      << " for every method (BO-ICP's concurrent ICP runs and acquisition, the pyramid's grid "
+         "scoring, and "
          "Open3D through omp_set_num_threads and OMP_NUM_THREADS set before its first call); "
          "OMP_WAIT_POLICY="
       << (std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "unset") << "\n"
