@@ -29,7 +29,10 @@ std::vector<ResultRow> RunScaling(const BenchPair& pair, const DatasetSettings& 
     for (double factor : plan.voxel_factors) {
       BoIcpConfig config = base;
       config.voxel = base.voxel * factor;
-      if (std::string(experiment) == "scaling-voxel-all") config.evaluation_points = 0;
+      if (std::string(experiment) == "scaling-voxel-all") {
+        config.evaluation_points = 0;
+        config.coarse_icp_points = 0;
+      }
       run(config, experiment);
     }
   }

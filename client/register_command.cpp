@@ -25,6 +25,7 @@ struct RegisterFlags {
   std::optional<double> voxel, refine_voxel, max_correspondence, truncation, min_range, max_range;
   std::optional<int> random_samples, iterations, icp_iterations;
   std::optional<size_t> evaluation_points;
+  std::optional<size_t> coarse_icp_points;
   uint64_t seed = 1;
   // One thread by default: splitting each ICP iteration across threads pays
   // only on an idle machine (config C on the demo pair, busy 2-core box: 79 s with 2 threads, 8 s
@@ -46,6 +47,7 @@ BoIcpConfig BuildConfig(const RegisterFlags& f) {
   if (f.random_samples) config.random_samples = *f.random_samples;
   if (f.iterations) config.iterations = *f.iterations;
   if (f.evaluation_points) config.evaluation_points = *f.evaluation_points;
+  if (f.coarse_icp_points) config.coarse_icp_points = *f.coarse_icp_points;
   if (!f.translation_bounds.empty()) {
     config.translation_bounds = ParseTriple(f.translation_bounds, "--translation-bounds");
   }
@@ -178,6 +180,8 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
   app.add_option("--iterations", f.iterations, "N: BO iterations per stage");
   app.add_option("--evaluation-points", f.evaluation_points,
                  "Source points used by each evaluation (0 = all)");
+  app.add_option("--coarse-icp-points", f.coarse_icp_points,
+                 "Points each evaluation's ICP starts on before it finishes on all (0 = all)");
   app.add_option("--min-range", f.min_range, "Drop points closer than this (metres)");
   app.add_option("--max-range", f.max_range, "Drop points farther than this (metres)");
   return [flags] { return RunRegister(*flags); };

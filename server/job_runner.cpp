@@ -181,12 +181,16 @@ class JobRun {
     return queue_.empty();
   }
 
-  // Hands pairs to the pool until the job's share of it is used.
+  // Hands pairs to the pool until the job's share of it is used. A fixed plan
+  // keeps one more pair waiting in the pool, so a worker that finishes a pair
+  // starts the next at once instead of idling while this thread stores the
+  // last one. Keyframe probes wait: the next probe depends on the results.
   void LaunchAvailable() {
+    const int limit = ctx_.max_pairs_in_flight + (planner_ ? 0 : 1);
     for (;;) {
       {
         std::lock_guard<std::mutex> lock(control_.mutex);
-        if (in_flight_ >= ctx_.max_pairs_in_flight) return;
+        if (in_flight_ >= limit) return;
       }
       const std::optional<PairIndex> next = NextPair();
       if (!next) return;

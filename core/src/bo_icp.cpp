@@ -20,15 +20,23 @@ namespace {
 // Distinct seeds for the independent random choices of one registration.
 constexpr uint64_t kSubsampleSalt = 0x9e3779b97f4a7c15ULL;
 constexpr uint64_t kStageSalt = 0xbf58476d1ce4e5b9ULL;
+constexpr uint64_t kCoarseSalt = 0x94d049bb133111ebULL;
 
 // Everything one registration evaluates against, built once per pair.
 struct PairContext {
   const PreparedPair& prepared;
   Points evaluation_source;  // subsample of prepared.search_source used by every BO evaluation
+  Points coarse_source;      // subsample of evaluation_source for the first part of each ICP run
   IcpOptions search_icp;
 };
 
 class Search {
+  struct Finished {
+    Eigen::VectorXd x;
+    Evaluation evaluation;
+    bool converged;  // its end may be joined by later runs
+  };
+
  public:
   Search(const PairContext& pair, const BoIcpConfig& config, const RegistrationCallbacks& callbacks)
       : pair_(pair), config_(config), callbacks_(callbacks) {}
@@ -42,21 +50,30 @@ class Search {
     options.iterations = config_.iterations;
     options.threads = config_.threads;
     std::mutex mutex;
-    std::vector<std::pair<Eigen::VectorXd, Evaluation>> finished;
+    std::vector<Finished> finished;
+    size_t committed = 0;  // entries of `finished` whose ends are in known_ends_
     // Only translation-only stages abandon hopeless starts: a start that must
     // rotate slides slowly and then snaps into its basin, so its recent
     // progress says little about where it ends (measured on 7-Scenes:
     // abandoning in the rotation stage lost the true basin on 1 of 4 pairs).
     const bool may_abandon = config_.abandon_hopeless && !space.SearchesRotation();
     const BoundedObjective objective = [&](const Eigen::VectorXd& u, double incumbent) {
+      bool converged = false;
       const Evaluation evaluation =
           Evaluate(stage, space.ToTransform(u),
-                   may_abandon ? incumbent : std::numeric_limits<double>::infinity());
+                   may_abandon ? incumbent : std::numeric_limits<double>::infinity(), converged);
       const std::lock_guard<std::mutex> lock(mutex);
-      finished.emplace_back(u, evaluation);
+      finished.push_back({u, evaluation, converged});
       return evaluation.objective;
     };
+    // Progress comes once a round is complete, so every run of a round sees
+    // the same known ends, whatever the thread count.
     const BayesOptProgress progress = [&](int done, int total, double best) {
+      for (; committed < finished.size(); ++committed) {
+        if (!finished[committed].converged) continue;
+        known_ends_.push_back(finished[committed].evaluation.result);
+        known_objectives_.push_back(finished[committed].evaluation.objective);
+      }
       if (callbacks_.progress) callbacks_.progress({name, done, total, best});
     };
     std::vector<Eigen::VectorXd> starts = {Eigen::VectorXd::Constant(space.dimension(), 0.5)};
@@ -78,19 +95,38 @@ class Search {
 
  private:
   // The paper's objective: the error ICP reaches when started from T0. Runs
-  // that cannot get below `abandon_above` are abandoned early.
-  Evaluation Evaluate(int stage, const Transform& initial, double abandon_above) const {
+  // that cannot get below `abandon_above` are abandoned early; runs that reach
+  // the end of an earlier run take over its result. `converged` tells whether
+  // the run found an end of its own.
+  Evaluation Evaluate(int stage, const Transform& initial, double abandon_above,
+                      bool& converged) const {
     const NearestNeighborIndex& target = pair_.prepared.search_target;
     Evaluation evaluation{stage, initial, initial, 0.0, false};
+    converged = false;
     if (callbacks_.local_icp) {
       evaluation.result = callbacks_.local_icp(pair_.evaluation_source, target.points(), initial);
     } else {
       IcpOptions options = pair_.search_icp;
       options.abandon_above = abandon_above;
       options.truncation = config_.EffectiveTruncation();
-      const IcpResult icp = AlignPointToPoint(pair_.evaluation_source, target, initial, options);
+      IcpResult icp;
+      icp.transform = initial;
+      if (pair_.coarse_source.size() < pair_.evaluation_source.size()) {
+        icp = AlignPointToPoint(pair_.coarse_source, target, initial, options, known_ends_);
+        options.max_iterations =
+            std::max(options.max_iterations - icp.iterations, config_.finish_icp_iterations);
+      }
+      if (icp.joined_end < 0 && !icp.abandoned) {
+        icp =
+            AlignPointToPoint(pair_.evaluation_source, target, icp.transform, options, known_ends_);
+      }
       evaluation.result = icp.transform;
       evaluation.abandoned = icp.abandoned;
+      if (icp.joined_end >= 0) {
+        evaluation.objective = known_objectives_[icp.joined_end];
+        return evaluation;
+      }
+      converged = icp.converged;
     }
     evaluation.objective = ScoreAlignment(pair_.evaluation_source, target, evaluation.result,
                                           config_.EffectiveTruncation())
@@ -101,11 +137,11 @@ class Search {
   // Evaluations of a round finish in any order; the history keeps the order
   // in which BO proposed them, so it does not depend on the thread count.
   void AppendInProposalOrder(const std::vector<BayesOptSample>& proposals,
-                             std::vector<std::pair<Eigen::VectorXd, Evaluation>>& finished) {
+                             std::vector<Finished>& finished) {
     for (const BayesOptSample& sample : proposals) {
       const auto match = std::find_if(finished.begin(), finished.end(),
-                                      [&](const auto& entry) { return entry.first == sample.x; });
-      history_.push_back(match->second);
+                                      [&](const Finished& entry) { return entry.x == sample.x; });
+      history_.push_back(match->evaluation);
       finished.erase(match);
     }
   }
@@ -114,6 +150,10 @@ class Search {
   const BoIcpConfig& config_;
   const RegistrationCallbacks& callbacks_;
   std::vector<Evaluation> history_;
+  // Ends of the converged runs of finished rounds (all stages: they share the
+  // ICP problem), and their objectives.
+  std::vector<Transform> known_ends_;
+  std::vector<double> known_objectives_;
 };
 
 // Unit coordinates of translation t in a translation-only search box, clamped
@@ -154,9 +194,11 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   ValidateConfig(config);
 
   const PreparedPair prepared = PreparePair(source, target, config);
-  const PairContext pair{prepared,
-                         RandomSubsample(prepared.search_source, config.evaluation_points,
-                                         config.seed ^ kSubsampleSalt),
+  Points evaluation_source = RandomSubsample(prepared.search_source, config.evaluation_points,
+                                             config.seed ^ kSubsampleSalt);
+  Points coarse_source =  // 0 points: all of them, so there is no separate first part
+      RandomSubsample(evaluation_source, config.coarse_icp_points, config.seed ^ kCoarseSalt);
+  const PairContext pair{prepared, std::move(evaluation_source), std::move(coarse_source),
                          SearchIcpOptions(config)};
   const Points& search_source = prepared.search_source;
 

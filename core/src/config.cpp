@@ -89,6 +89,7 @@ void ValidateConfig(const BoIcpConfig& c) {
   Require(std::isfinite(c.objective_truncation) && c.objective_truncation >= 0.0,
           "objective truncation must be >= 0 (0 = 1.5 x voxel)");
   Require(c.icp_max_iterations >= 1, "ICP iterations must be at least 1");
+  Require(c.finish_icp_iterations >= 1, "ICP finishing iterations must be at least 1");
   Require(c.refine_candidates >= 1, "refine candidates must be at least 1");
   Require(c.refine_max_iterations >= 1, "refinement ICP iterations must be at least 1");
   Require(std::isfinite(c.refine_voxel) && c.refine_voxel >= 0.0 && c.refine_voxel <= c.voxel,

@@ -48,6 +48,24 @@ double TruncatedMean(const std::vector<size_t>& match, const std::vector<double>
   return sum / static_cast<double>(std::max<size_t>(match.size(), 1));
 }
 
+// Index of the known end nearest to T in translation among those within both
+// join radii, or -1.
+int JoinedEnd(const Transform& T, const std::vector<Transform>& known_ends,
+              const IcpOptions& options) {
+  if (!(options.join_translation > 0.0)) return -1;
+  int joined = -1;
+  double nearest = options.join_translation;
+  for (size_t k = 0; k < known_ends.size(); ++k) {
+    const Transform delta = known_ends[k].inverse() * T;
+    const double distance = TranslationNorm(delta);
+    if (distance <= nearest && RotationAngle(delta) <= options.join_rotation) {
+      nearest = distance;
+      joined = static_cast<int>(k);
+    }
+  }
+  return joined;
+}
+
 }  // namespace
 
 double ProjectedLimit(double f0, double f1, double f2, int remaining_steps) {
@@ -70,7 +88,8 @@ Transform RigidFromCrossCovariance(const Point& source_mean, const Point& target
 }
 
 IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& target,
-                            const Transform& initial, const IcpOptions& options) {
+                            const Transform& initial, const IcpOptions& options,
+                            const std::vector<Transform>& known_ends) {
   IcpResult result;
   result.transform = initial;
   Points moved(source.size());
@@ -87,6 +106,12 @@ IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& ta
   double history[3] = {0.0, 0.0, 0.0};
 
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    result.joined_end = JoinedEnd(result.transform, known_ends, options);
+    if (result.joined_end >= 0) {
+      result.transform = known_ends[result.joined_end];
+      result.converged = true;
+      return result;
+    }
     const Eigen::Matrix3d R = result.transform.topLeftCorner<3, 3>();
     const Eigen::Vector3d t = result.transform.topRightCorner<3, 1>();
     MatchNearest(source, target, R, t, max_sq, options.threads, moved, match, sq_distance);

@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <string>
 
+#include "boicp/parallel_for.hpp"
 #include "boicp/preprocess.hpp"
 
 namespace boicp {
 namespace {
+
+constexpr uint64_t kLevelSalt = 0xd6e8feb86659fd93ULL;
 
 std::vector<double> RefinementVoxels(double search_voxel, double refine_voxel) {
   std::vector<double> voxels;
@@ -36,16 +40,39 @@ IcpOptions SearchIcpOptions(const BoIcpConfig& config) {
   // with a fifth fewer iterations than 1/1000 voxel and 1e-4 rad).
   options.convergence_translation = 1e-2 * config.voxel;
   options.convergence_rotation = 1e-3;
+  // Half a voxel and 0.6 degrees from a converged end, a run is inside its
+  // basin (a voxel and 1.1 degrees saved only 2 % more work).
+  if (config.join_converged_runs) {
+    options.join_translation = 0.5 * config.voxel;
+    options.join_rotation = 0.01;
+  }
   return options;
 }
 
 PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config) {
-  PreparedPair pair{PrepareCloud(source, config, config.voxel, "source"),
-                    NearestNeighborIndex(PrepareCloud(target, config, config.voxel, "target")),
-                    {}};
+  std::vector<double> voxels = {config.voxel};
   for (double voxel : RefinementVoxels(config.voxel, config.EffectiveRefineVoxel())) {
-    pair.pyramid.push_back({voxel, PrepareCloud(source, config, voxel, "source"),
-                            NearestNeighborIndex(PrepareCloud(target, config, voxel, "target"))});
+    voxels.push_back(voxel);
+  }
+  // Every cloud of every level is independent of the others, so they are
+  // built at once on the registration's threads; the search level's source
+  // keeps every point, the finer ones at most refine_source_points.
+  std::vector<Points> sources(voxels.size());
+  std::vector<std::optional<NearestNeighborIndex>> targets(voxels.size());
+  ParallelFor(2 * voxels.size(), config.threads, [&](size_t task) {
+    const size_t level = task / 2;
+    if (task % 2 == 1) {
+      targets[level].emplace(PrepareCloud(target, config, voxels[level], "target"));
+    } else if (level == 0) {
+      sources[level] = PrepareCloud(source, config, voxels[level], "source");
+    } else {
+      sources[level] = RandomSubsample(PrepareCloud(source, config, voxels[level], "source"),
+                                       config.refine_source_points, config.seed ^ kLevelSalt);
+    }
+  });
+  PreparedPair pair{std::move(sources[0]), std::move(*targets[0]), {}};
+  for (size_t level = 1; level < voxels.size(); ++level) {
+    pair.pyramid.push_back({voxels[level], std::move(sources[level]), std::move(*targets[level])});
   }
   return pair;
 }
@@ -66,6 +93,9 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   // are below 1/1000 voxel and 1e-4 rad (the search's 1/100 voxel and 1e-3
   // rad cost the bunny 0.2-0.5 degrees and one flipped pair).
   options.convergence_rotation = 1e-4;
+  // One run at a time (each may stop on its leader's score), so the threads
+  // go to its nearest-neighbour searches, which do not change the result.
+  options.threads = config.threads;
   // The search level first, then the pyramid, finest last.
   const auto run_level = [&](const Points& source, const NearestNeighborIndex& target, double voxel,
                              double gate) {
@@ -77,9 +107,9 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
       options.abandon_above = k == 0 ? std::numeric_limits<double>::infinity() : survivors[0].score;
       const IcpResult icp = AlignPointToPoint(source, target, alive[k].T, options);
       if (icp.abandoned) continue;
-      survivors.push_back(
-          {icp.transform,
-           ScoreAlignment(source, target, icp.transform, options.truncation).truncated_mean});
+      survivors.push_back({icp.transform, ScoreAlignment(source, target, icp.transform,
+                                                         options.truncation, options.threads)
+                                              .truncated_mean});
     }
     // Leader of the next level first; the sort is stable so ties keep the search's order.
     std::stable_sort(survivors.begin(), survivors.end(),
@@ -92,8 +122,8 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   }
   const PyramidLevel& finest = pair.pyramid.back();
   const Transform& best = alive.front().T;
-  return {best,
-          ScoreAlignment(finest.source, finest.target, best, config.EffectiveInlierDistance())};
+  return {best, ScoreAlignment(finest.source, finest.target, best, config.EffectiveInlierDistance(),
+                               config.threads)};
 }
 
 }  // namespace boicp

@@ -57,10 +57,54 @@ INSTANTIATE_TEST_SUITE_P(Modes, BoIcpModes,
                                                                        : std::string("Nested");
                          });
 
+// The two shortcuts of the search ICP, each on and off.
+struct Shortcuts {
+  size_t coarse_icp_points;
+  bool join_converged_runs;
+};
+
+class BoIcpShortcuts : public ::testing::TestWithParam<Shortcuts> {};
+
+TEST_P(BoIcpShortcuts, RecoverLargeYawAndJoinedRunsCopyAnEarlierEnd) {
+  const StreetPair pair = MakeStreetPair(2.3);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.coarse_icp_points = GetParam().coarse_icp_points;
+  config.join_converged_runs = GetParam().join_converged_runs;
+  const RegistrationResult result = RegisterPair(pair.source, pair.target, config);
+  EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
+  EXPECT_LT(TranslationErrorM(result.transform, pair.truth), 0.1);
+
+  // A joined run reports an earlier run's end bit for bit, with its score;
+  // independent runs never end on exactly the same transform.
+  int copies = 0;
+  for (size_t i = 0; i < result.history.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (result.history[i].result != result.history[j].result) continue;
+      EXPECT_EQ(result.history[i].objective, result.history[j].objective) << i << " copies " << j;
+      ++copies;
+      break;
+    }
+  }
+  if (config.join_converged_runs) {
+    EXPECT_GT(copies, 0);
+  } else {
+    EXPECT_EQ(copies, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(OnOff, BoIcpShortcuts,
+                         ::testing::Values(Shortcuts{0, false}, Shortcuts{500, false},
+                                           Shortcuts{0, true}, Shortcuts{500, true}),
+                         [](const auto& info) {
+                           return std::string(info.param.coarse_icp_points ? "Coarse" : "Single") +
+                                  (info.param.join_converged_runs ? "Joining" : "Independent");
+                         });
+
 TEST(BoIcp, SameSeedSameAnswerAndThreadCountDoesNotMatter) {
   const StreetPair pair = MakeStreetPair(0.9);
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 5;
+  config.coarse_icp_points = 500;  // both parts of every ICP run, and joins
   const RegistrationResult a = RegisterPair(pair.source, pair.target, config);
   config.threads = 2;  // the parallel twin: the same rounds, evaluated two at a time
   const RegistrationResult b = RegisterPair(pair.source, pair.target, config);
@@ -117,7 +161,9 @@ TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
   const StreetPair pair = MakeStreetPair(0.9);
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 3;
-  config.abandon_hopeless = false;  // the hook runs every ICP to the end
+  config.abandon_hopeless = false;     // the hook runs every ICP to the end...
+  config.coarse_icp_points = 0;        // ...in one part...
+  config.join_converged_runs = false;  // ...and to its own end
   const RegistrationResult plain = RegisterPair(pair.source, pair.target, config);
 
   // A hook that runs core's own ICP must reproduce the search exactly...

@@ -70,6 +70,9 @@ TEST(Config, RejectsInvalidFieldsByName) {
   c.max_range = 1.0;
   c.min_range = 2.0;
   EXPECT_THAT(ValidationMessage(c), HasSubstr("range"));
+  c = PresetConfig("A");
+  c.finish_icp_iterations = 0;
+  EXPECT_THAT(ValidationMessage(c), HasSubstr("finishing iterations"));
   EXPECT_THROW(PresetConfig("D"), InputError);
   EXPECT_THROW(ParseSearchMode("5dof"), InputError);
 }

@@ -97,6 +97,44 @@ TEST(Icp, AbandonsOnlyRunsThatCannotBeatTheBound) {
   EXPECT_THROW(AlignPointToPoint(source, index, Transform::Identity(), options), InputError);
 }
 
+TEST(Icp, JoinsAKnownEndOnlyWithinTheJoinRadii) {
+  const Points target = StreetSample();
+  const Points source = TransformPoints(SmallMotion().inverse(), target);
+  const NearestNeighborIndex index(target);
+  IcpOptions options;
+  options.max_correspondence_distance = 1.0;
+  options.max_iterations = 60;
+  const IcpResult own = AlignPointToPoint(source, index, Transform::Identity(), options);
+  ASSERT_TRUE(own.converged);
+  ASSERT_GT(own.iterations, 3);
+  Transform elsewhere = own.transform;
+  elsewhere(0, 3) += 5.0;
+  const std::vector<Transform> ends = {elsewhere, own.transform};
+
+  // Radii off: the run ignores the known ends and repeats its own path.
+  const IcpResult unjoined = AlignPointToPoint(source, index, Transform::Identity(), options, ends);
+  EXPECT_EQ(unjoined.joined_end, -1);
+  EXPECT_TRUE(unjoined.transform == own.transform);
+  EXPECT_EQ(unjoined.iterations, own.iterations);
+
+  // With radii the run stops where it enters the second end's neighbourhood,
+  // sooner, and returns that end exactly.
+  options.join_translation = 0.05;
+  options.join_rotation = 0.01;
+  const IcpResult joined = AlignPointToPoint(source, index, Transform::Identity(), options, ends);
+  EXPECT_EQ(joined.joined_end, 1);
+  EXPECT_TRUE(joined.converged);
+  EXPECT_TRUE(joined.transform == own.transform);
+  EXPECT_LT(joined.iterations, own.iterations);
+
+  // A start outside every neighbourhood that converges far from the known
+  // ends runs to its own end.
+  const IcpResult far =
+      AlignPointToPoint(source, index, Transform::Identity(), options, {elsewhere});
+  EXPECT_EQ(far.joined_end, -1);
+  EXPECT_TRUE(far.transform == own.transform);
+}
+
 TEST(Icp, StopsWithoutCorrespondences) {
   const Points target = {Point(0, 0, 0), Point(1, 0, 0), Point(0, 1, 0)};
   const Points source = {Point(100, 0, 0), Point(101, 0, 0), Point(100, 1, 0)};

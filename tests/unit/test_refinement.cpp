@@ -18,13 +18,34 @@ BoIcpConfig StreetConfig() {
 
 TEST(Refinement, PyramidHalvesFromTheSearchVoxelDownToTheRefineVoxel) {
   const Points street = MakeSyntheticStreet(5, 20.0);
-  const PreparedPair pair = PreparePair(street, street, StreetConfig());
+  BoIcpConfig config = StreetConfig();
+  config.refine_source_points = 0;
+  const PreparedPair pair = PreparePair(street, street, config);
   ASSERT_EQ(pair.pyramid.size(), 3u);  // 0.3, 0.15, then the 0.1 refine voxel
   EXPECT_DOUBLE_EQ(pair.pyramid[0].voxel, 0.3);
   EXPECT_DOUBLE_EQ(pair.pyramid[1].voxel, 0.15);
   EXPECT_DOUBLE_EQ(pair.pyramid[2].voxel, 0.1);
   EXPECT_LT(pair.search_source.size(), pair.pyramid[0].source.size());
   EXPECT_LT(pair.pyramid[0].source.size(), pair.pyramid[2].source.size());
+}
+
+TEST(Refinement, LevelSourcesKeepAtMostRefineSourcePointsAndTargetsKeepAll) {
+  const Points street = MakeSyntheticStreet(5, 20.0);
+  BoIcpConfig config = StreetConfig();
+  config.refine_source_points = 0;  // all
+  const PreparedPair all = PreparePair(street, street, config);
+  const size_t finest = all.pyramid.back().source.size();
+  ASSERT_GT(finest, 1000u);
+  EXPECT_EQ(finest, all.pyramid.back().target.size());
+
+  config.refine_source_points = 1000;
+  const PreparedPair capped = PreparePair(street, street, config);
+  for (size_t k = 0; k < capped.pyramid.size(); ++k) {
+    EXPECT_EQ(capped.pyramid[k].source.size(),
+              std::min<size_t>(1000, all.pyramid[k].source.size()));
+    EXPECT_EQ(capped.pyramid[k].target.size(), all.pyramid[k].target.size());
+  }
+  EXPECT_EQ(capped.search_source.size(), all.search_source.size());
 }
 
 // A street scan and the same scan moved by `truth`^-1, so T_target_source = truth.

@@ -73,9 +73,10 @@ using BayesOptProgress = std::function<void(int done, int total, double best_y)>
 /// hyperparameters are refitted by one L-BFGS run from the previous ones when
 /// refit_every evaluations have come in since the last fit, and held (the GP
 /// only conditioned on the new data) otherwise. progress is called after every evaluation, in
-/// proposal order. Invalid options, malformed initial points and non-finite objective values (the
-/// message names the 0-based evaluation index) throw boicp::InputError. One std::mt19937_64(seed)
-/// drives every random choice, so a seed reproduces the run bit for bit.
+/// proposal order, once its whole round has been evaluated. Invalid options, malformed initial
+/// points and non-finite objective values (the message names the 0-based evaluation index) throw
+/// boicp::InputError. One std::mt19937_64(seed) drives every random choice, so a seed reproduces
+/// the run bit for bit.
 BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points = {},

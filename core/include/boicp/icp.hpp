@@ -2,6 +2,7 @@
 // Point-to-point ICP (Besl & McKay) against a prebuilt target index.
 
 #include <limits>
+#include <vector>
 
 #include "boicp/nearest_neighbors.hpp"
 #include "boicp/types.hpp"
@@ -25,6 +26,11 @@ struct IcpOptions {
   double abandon_above = std::numeric_limits<double>::infinity();  // metres
   double truncation = 0.0;                                         // metres
   int abandon_after = 5;  // iterations always run before a run may be abandoned
+
+  // How close a run must come to a known end (see AlignPointToPoint) to stop
+  // there: translation (metres) and angle (radians) of T_end^-1 * T. 0 = never.
+  double join_translation = 0.0;
+  double join_rotation = 0.0;
 };
 
 /// Outcome of one ICP run. `transform` is T_target_source: p_target = T * p_source.
@@ -35,6 +41,7 @@ struct IcpResult {
   size_t correspondences = 0;  // in the last iteration
   double rmse = 0.0;           // of the last iteration's correspondences, metres
   bool abandoned = false;      // stopped because it could not beat options.abandon_above
+  int joined_end = -1;         // index into known_ends of the end it stopped at, or -1
 };
 
 /// Rigid transform that best maps the `source` points onto their paired
@@ -53,7 +60,14 @@ double ProjectedLimit(double f0, double f1, double f2, int remaining_steps);
 /// Runs ICP from `initial`. Allocates its scratch buffers once per call, never
 /// per iteration. With fewer than 3 correspondences it stops and returns the
 /// last transform with converged = false.
+///
+/// `known_ends` are where earlier runs on the same problem converged. A
+/// converged end attracts the runs that pass close to it, so once this run
+/// comes within options.join_translation and options.join_rotation of one it
+/// stops and returns that end (the nearest in translation) as converged, with
+/// joined_end set, instead of crawling through the same last small steps.
 IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& target,
-                            const Transform& initial, const IcpOptions& options);
+                            const Transform& initial, const IcpOptions& options,
+                            const std::vector<Transform>& known_ends = {});
 
 }  // namespace boicp

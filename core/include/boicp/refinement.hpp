@@ -27,9 +27,9 @@ IcpOptions SearchIcpOptions(const BoIcpConfig& config);
 
 /// One level of the refinement pyramid.
 struct PyramidLevel {
-  double voxel = 0.0;  // metres
-  Points source;
-  NearestNeighborIndex target;
+  double voxel = 0.0;           // metres
+  Points source;                // at most config.refine_source_points of them (random, seeded)
+  NearestNeighborIndex target;  // every point at this voxel
 };
 
 /// Both clouds of a pair at the search voxel and at every refinement level,
