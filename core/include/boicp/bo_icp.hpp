@@ -13,7 +13,9 @@
 
 namespace boicp {
 
-/// One ICP run started by the search.
+/// One ICP run started by the search. A run that reached the end of an
+/// earlier converged run (BoIcpConfig::join_converged_runs) reports that end
+/// and its objective.
 struct Evaluation {
   int stage = 0;                              // 0 = rotation / joint, 1 = translation
   Transform initial = Transform::Identity();  // T0 that BO proposed
