@@ -21,6 +21,13 @@ Transform SmallMotion() {
 
 Points StreetSample() { return VoxelDownsample(MakeSyntheticStreet(3, 20.0), 0.3); }
 
+// The street as target and the street moved by SmallMotion()^-1 as source.
+struct MovedStreet {
+  Points target = StreetSample();
+  Points source = TransformPoints(SmallMotion().inverse(), target);
+  NearestNeighborIndex index{target};
+};
+
 TEST(Icp, RecoversKnownSmallTransformExactlyOnNoiselessData) {
   const Points target = StreetSample();
   const Transform truth = SmallMotion();
@@ -40,9 +47,9 @@ TEST(Icp, RecoversKnownSmallTransformExactlyOnNoiselessData) {
 }
 
 TEST(Icp, SerialAndParallelGiveIdenticalResults) {
-  const Points target = StreetSample();
-  const Points source = TransformPoints(SmallMotion().inverse(), target);
-  const NearestNeighborIndex index(target);
+  const MovedStreet street;
+  const Points& source = street.source;
+  const NearestNeighborIndex& index = street.index;
   IcpOptions serial;
   serial.max_correspondence_distance = 1.0;
   IcpOptions parallel = serial;
@@ -66,9 +73,9 @@ TEST(Icp, ProjectedLimitExtrapolatesTheFasterOfTheLastTwoSteps) {
 }
 
 TEST(Icp, AbandonsOnlyRunsThatCannotBeatTheBound) {
-  const Points target = StreetSample();
-  const Points source = TransformPoints(SmallMotion().inverse(), target);
-  const NearestNeighborIndex index(target);
+  const MovedStreet street;
+  const Points& source = street.source;
+  const NearestNeighborIndex& index = street.index;
   IcpOptions options;
   options.max_correspondence_distance = 1.0;
   options.max_iterations = 40;
@@ -98,9 +105,9 @@ TEST(Icp, AbandonsOnlyRunsThatCannotBeatTheBound) {
 }
 
 TEST(Icp, JoinsAKnownEndOnlyWithinTheJoinRadii) {
-  const Points target = StreetSample();
-  const Points source = TransformPoints(SmallMotion().inverse(), target);
-  const NearestNeighborIndex index(target);
+  const MovedStreet street;
+  const Points& source = street.source;
+  const NearestNeighborIndex& index = street.index;
   IcpOptions options;
   options.max_correspondence_distance = 1.0;
   options.max_iterations = 60;
