@@ -18,6 +18,12 @@ std::string SearchModeName(SearchMode mode) {
   return mode == SearchMode::kNested ? "nested" : "6dof";
 }
 
+BayesOptOptions RegistrationBayesOptOptions() {
+  BayesOptOptions options;
+  options.acquisition.random_candidates = 1000;
+  return options;
+}
+
 double BoIcpConfig::EffectiveMaxCorrespondence() const {
   return max_correspondence_distance > 0.0 ? max_correspondence_distance : 3.0 * voxel;
 }
