@@ -94,7 +94,7 @@ struct BoIcpConfig {
   // candidates per proposal instead of the library's 2000: a nested stage
   // searches 3 dimensions, and BOBYQA refines the best five anyway. Over the
   // bench's 35 pairs at three seeds (with finish_icp_iterations 5) the
-  // surrogate's time fell by a quarter with as many successes.
+  // surrogate's time fell by about a third with as many successes.
   BayesOptOptions bo = RegistrationBayesOptOptions();
 
   uint64_t seed = 1;  // drives the initial design, subsampling and acquisition
