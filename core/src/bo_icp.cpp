@@ -254,7 +254,11 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   result.objective = best.objective;
   result.fitness = final_alignment.score.fitness;
   result.inlier_rmse = final_alignment.score.inlier_rmse;
+  result.overlap = ScoreAlignment(search_source, prepared.search_target, result.transform,
+                                  1.5 * config.voxel, config.threads)
+                       .fitness;
   result.confidence = result.fitness * (1.0 - result.probability_better);
+  result.doubtful = result.confidence < kDoubtfulBelow;
   result.gp_mean = last.gp_mean_at_best;
   result.gp_std = last.gp_std_at_best;
   result.evaluations = static_cast<int>(search.history().size());

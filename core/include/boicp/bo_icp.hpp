@@ -24,6 +24,9 @@ struct Evaluation {
   bool abandoned = false;  // ICP stopped early: it could not beat the incumbent of its round
 };
 
+/// A result whose confidence is below this is reported as doubtful.
+constexpr double kDoubtfulBelow = 0.5;
+
 /// Result of registering one pair. Frame convention: `transform` is
 /// T_target_source, so p_target = transform * p_source (metres, radians).
 struct RegistrationResult {
@@ -31,10 +34,13 @@ struct RegistrationResult {
   double objective = 0.0;    // best search objective (truncated mean NN distance, metres)
   double fitness = 0.0;      // fraction of refined source points within inlier_distance
   double inlier_rmse = 0.0;  // RMS distance of those points, metres
-  /// In [0,1]: fitness x (1 - probability_better). High when most of the
-  /// source lies on the target and the surrogate sees no unexplored region
-  /// likely to beat the answer.
+  /// Fraction of the search-voxel source within 1.5 search voxels of the
+  /// target: how much of the source the target sees, for keyframe choice.
+  double overlap = 0.0;
+  /// Estimated probability, in [0,1], that `transform` is within the success
+  /// thresholds (2 degrees, and a few refinement voxels).
   double confidence = 0.0;
+  bool doubtful = false;  // confidence < kDoubtfulBelow
   double gp_mean = 0.0;             // GP posterior mean at the optimum (last stage), metres
   double gp_std = 0.0;              // GP posterior standard deviation there, metres
   double probability_better = 0.0;  // max over stages of the GP's P(some other point is better)
