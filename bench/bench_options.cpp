@@ -87,7 +87,7 @@ std::string UsageText() {
          "  --methods M[,M...]        default all: " +
          methods +
          "\n"
-         "  --perturb yaw|axis90|none source perturbation (default: per dataset)\n"
+         "  --perturb yaw|axis90|any|none  source perturbation (default: per dataset)\n"
          "  --max-angle-deg A         largest axis perturbation angle (default 90)\n"
          "  --seed N                  base seed of every random choice (default 1)\n"
          "  --threads T               thread budget of every method (default 1)\n"
@@ -101,7 +101,10 @@ std::string UsageText() {
          "                            on the first pair of these datasets\n"
          "  --synthetic N             add N generated street pairs (no files needed)\n"
          "  --scaling-only            only the scaling study of the --scaling datasets\n"
-         "  --quick                   smoke-test budgets (see summary.md)\n";
+         "  --quick                   smoke-test budgets (see summary.md)\n"
+         "  --auto-settings           BO methods choose voxel and boxes from the clouds\n"
+         "                            (no dataset table); the rest keep the table's\n"
+         "  --no-retry                BO methods never search a doubtful pair again\n";
 }
 
 BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
@@ -159,6 +162,14 @@ BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
     }
     if (flag == "--scaling-only") {
       options.scaling_only = true;
+      continue;
+    }
+    if (flag == "--auto-settings") {
+      o.automatic_settings = true;
+      continue;
+    }
+    if (flag == "--no-retry") {
+      o.retry_when_doubtful = false;
       continue;
     }
     if (flag == "--help" || flag == "-h") {

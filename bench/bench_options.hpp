@@ -1,7 +1,8 @@
 #pragma once
 // Command line of boicp-bench. Scripts rely on:
 //   --pairs CSV[,CSV...] --methods M[,M...] --perturb yaw|axis90|none --seed N
-//   --threads T --out DIR [--voxel V --translation-bounds X,Y,Z]
+//   --threads T --out DIR [--voxel V --translation-bounds X,Y,Z --auto-settings
+//   --no-retry]
 
 #include <cstdint>
 #include <optional>
@@ -30,6 +31,8 @@ struct DatasetOverrides {
   std::optional<Eigen::Vector3d> translation_bounds;
   std::optional<double> max_rot_deg;  // success thresholds
   std::optional<double> max_trans_m;
+  bool automatic_settings = false;  // BO methods choose voxel and boxes from the clouds
+  bool retry_when_doubtful = true;  // BO methods search again when doubtful
 };
 
 struct BenchOptions {

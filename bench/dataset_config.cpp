@@ -6,9 +6,13 @@ namespace boicp::bench {
 
 BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input) {
   BoIcpConfig config = PresetConfig(preset);
-  config.voxel = input.dataset.voxel * config.voxel / PresetConfig("C").voxel;
-  config.rotation_bounds = input.dataset.rotation_bounds;
-  config.translation_bounds = input.dataset.translation_bounds;
+  config.retry_when_doubtful = input.dataset.retry_when_doubtful;
+  if (!input.dataset.automatic_settings) {
+    config.automatic.clear();
+    config.voxel = input.dataset.voxel * config.voxel / PresetConfig("C").voxel;
+    config.rotation_bounds = input.dataset.rotation_bounds;
+    config.translation_bounds = input.dataset.translation_bounds;
+  }
   config.seed = input.seed;
   config.threads = input.threads;
   if (input.quick) {

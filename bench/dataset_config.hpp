@@ -16,8 +16,9 @@ constexpr int kQuickBoSamples = 10;
 /// Preset `preset` ("A", "B", "C") adapted to the dataset: the preset's N_r
 /// and N (each at most kQuickBoSamples in quick mode), the dataset's bounds,
 /// and a search voxel of dataset.voxel scaled by the preset's voxel relative
-/// to C's (so A and B stay 7/6 coarser, as in the paper); the input's seed and
-/// thread budget.
+/// to C's (so A and B stay 7/6 coarser, as in the paper); or, with
+/// dataset.automatic_settings, voxel and bounds left for RegisterPair to
+/// choose from the pair. The input's seed and thread budget.
 BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input);
 
 }  // namespace boicp::bench

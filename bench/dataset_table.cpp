@@ -63,6 +63,8 @@ DatasetSettings SettingsForDataset(const std::string& folder_name,
   // A custom dataset's default translation tolerance is one voxel.
   if (s.max_trans_m <= 0.0) s.max_trans_m = s.voxel;
   if (overrides.max_trans_m) s.max_trans_m = *overrides.max_trans_m;
+  s.automatic_settings = overrides.automatic_settings;
+  s.retry_when_doubtful = overrides.retry_when_doubtful;
   return s;
 }
 
@@ -80,6 +82,9 @@ std::string DescribeSettings(const DatasetSettings& s) {
       s.translation_bounds[0], s.translation_bounds[1], s.translation_bounds[2], s.max_rot_deg,
       s.max_trans_m);
   std::string text = line;
+  if (s.automatic_settings)
+    text += "; BO methods: automatic settings (voxel and bounds above unused)";
+  if (!s.retry_when_doubtful) text += "; BO methods: no retries";
   if (s.depth_scale > 0.0) {
     text += ", depth PNG scale " + std::to_string(static_cast<int>(s.depth_scale)) + "/m with " +
             s.intrinsics_file;

@@ -22,8 +22,10 @@ struct DatasetSettings {
   Eigen::Vector3d translation_bounds{0.0, 0.0, 0.0};      // metres; also the perturbation's
   double max_rot_deg = 2.0;                               // success thresholds
   double max_trans_m = 0.0;
-  double depth_scale = 0.0;     // > 0: clouds are depth PNGs with this many units per metre
-  std::string intrinsics_file;  // depth PNGs: camera file, relative to the folder
+  double depth_scale = 0.0;         // > 0: clouds are depth PNGs with this many units per metre
+  std::string intrinsics_file;      // depth PNGs: camera file, relative to the folder
+  bool automatic_settings = false;  // BO methods ignore voxel and bounds and choose their own
+  bool retry_when_doubtful = true;
 };
 
 /// The table entry for `folder_name` (matched by prefix: "kitti", "7scenes",

@@ -20,8 +20,12 @@ MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& in
   output.evaluations = result.evaluations;
   output.source_points = result.source_points;
   output.target_points = result.target_points;
-  output.voxel = config.voxel;
+  output.voxel = result.config.voxel;
   output.iterations = config.iterations;
+  output.features = result.features;
+  output.attempts = static_cast<int>(result.attempts.size());
+  for (size_t k = 1; k < result.attempts.size(); ++k)
+    output.retry_s += result.attempts[k].runtime_s;
   output.icp_s = split.icp_s;
   output.model_s = split.model_s;
   return output;

@@ -12,6 +12,7 @@
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/Registration.h>
 
+#include "boicp/auto_settings.hpp"
 #include "boicp/bo_icp.hpp"
 #include "dataset_config.hpp"
 #include "methods.hpp"
@@ -21,6 +22,11 @@ namespace boicp::bench {
 MethodOutput RunNaiveBoIcp(const MethodInput& input) {
   namespace reg = open3d::pipelines::registration;
   BoIcpConfig config = DatasetBoConfig("C", input);
+  // The ICP below reads the config's gate, so automatic settings are chosen first.
+  ApplyChosenSettings(
+      ChooseSettingsForClouds({&input.source, &input.target}, CloudFormat::kAuto, config.seed),
+      config);
+  config.retry_when_doubtful = false;  // the paper's method searches once
   config.bo.batch_size = 1;
   config.bo.refit_every = 1;
   config.evaluation_points = 0;

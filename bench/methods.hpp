@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "boicp/confidence.hpp"
 #include "boicp/config.hpp"
 #include "boicp/types.hpp"
 #include "dataset_table.hpp"
@@ -33,6 +34,11 @@ struct MethodOutput {
   std::optional<int> iterations;  // BO: expected-improvement steps per stage
   std::optional<double> icp_s;    // BO only: estimated time inside ICP evaluations
   std::optional<double> model_s;  // BO only: the rest outside refinement (GP fit + acquisition)
+  // BO only: what confidence was computed from, searches made and the time of
+  // the retries among them.
+  std::optional<ConfidenceFeatures> features;
+  int attempts = 0;
+  double retry_s = 0.0;
 };
 
 /// Every method name, in the order tables and plots list them.

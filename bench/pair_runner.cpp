@@ -40,6 +40,9 @@ ResultRow Timed(const std::string& method, const BenchPair& pair, const DatasetS
     row.confidence = output.confidence;
     row.icp_s = output.icp_s;
     row.model_s = output.model_s;
+    row.features = output.features;
+    row.attempts = output.attempts;
+    row.retry_s = output.retry_s;
   } catch (const std::exception& e) {
     // Open3D reports its errors as std::runtime_error: a failed method is a
     // result (it counts against the success rate), not the end of the run.

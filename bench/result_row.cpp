@@ -28,13 +28,20 @@ std::string Text(const std::string& value) {
   return quoted + "\"";
 }
 
+std::string Features(const std::optional<ConfidenceFeatures>& f) {
+  if (!f) return ",,,,";
+  return Number(f->fitness) + ',' + Number(f->rmse_ratio) + ',' + Number(f->margin) + ',' +
+         Number(f->support) + ',' + Number(f->probability_better);
+}
+
 }  // namespace
 
 std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
   std::ostringstream out;
   out << "experiment,dataset,source,target,method,threads,seed,perturb,voxel,iterations,"
          "source_points,target_points,evaluations,wall_s,rot_err_deg,trans_err_m,mean_p2p_m,"
-         "overlap,success,confidence,icp_s,model_s,error\n";
+         "overlap,success,confidence,icp_s,model_s,attempts,retry_s,fitness,rmse_ratio,margin,"
+         "support,probability_better,error\n";
   for (const ResultRow& r : rows) {
     out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ',' << Text(r.target)
         << ',' << r.method << ',' << r.threads << ',' << r.seed << ',' << r.perturb << ','
@@ -43,7 +50,8 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
         << Number(r.wall_s, "%.4f") << ',' << Number(r.rot_err_deg) << ',' << Number(r.trans_err_m)
         << ',' << Number(r.mean_p2p_m) << ',' << Number(r.overlap, "%.4f") << ','
         << (r.success ? 1 : 0) << ',' << Optional(r.confidence) << ',' << Optional(r.icp_s) << ','
-        << Optional(r.model_s) << ',' << Text(r.error) << '\n';
+        << Optional(r.model_s) << ',' << r.attempts << ',' << Number(r.retry_s, "%.4f") << ','
+        << Features(r.features) << ',' << Text(r.error) << '\n';
   }
   return out.str();
 }

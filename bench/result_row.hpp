@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "boicp/confidence.hpp"
+
 namespace boicp::bench {
 
 struct ResultRow {
@@ -31,7 +33,10 @@ struct ResultRow {
   std::optional<double> confidence;
   std::optional<double> icp_s;
   std::optional<double> model_s;
-  std::string error;  // what the method threw, if it did
+  std::optional<ConfidenceFeatures> features;  // BO only
+  int attempts = 0;                            // BO only: searches made (2 = retried)
+  double retry_s = 0.0;                        // BO only: wall time of the retry, in wall_s
+  std::string error;                           // what the method threw, if it did
 };
 
 /// The CSV text: a header line, then one line per row. NaN and absent values

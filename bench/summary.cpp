@@ -56,16 +56,21 @@ double LogLogSlope(const std::vector<double>& x, const std::vector<double>& y) {
 void DatasetTable(std::ostringstream& out, const std::string& dataset,
                   const std::vector<ResultRow>& rows) {
   out << "| method | pairs | median wall s | mean wall s | median rot deg | mean rot deg | "
-         "median trans m | mean trans m | success | median confidence |\n"
-         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+         "median trans m | mean trans m | success | median confidence | median first search s "
+         "| retried | retry s |\n"
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const std::string& method : MethodNames()) {
-    std::vector<double> wall, rot, trans, confidence;
-    int pairs = 0, successes = 0, errors = 0;
+    std::vector<double> wall, first_search, rot, trans, confidence;
+    int pairs = 0, successes = 0, errors = 0, retried = 0;
+    double retry_s = 0.0;
     for (const ResultRow& r : rows) {
       if (r.experiment != "suite" || r.dataset != dataset || r.method != method) continue;
       ++pairs;
       successes += r.success ? 1 : 0;
       wall.push_back(r.wall_s);
+      first_search.push_back(r.wall_s - r.retry_s);
+      retried += r.attempts > 1 ? 1 : 0;
+      retry_s += r.retry_s;
       if (!r.error.empty()) {
         ++errors;
         continue;
@@ -83,7 +88,8 @@ void DatasetTable(std::ostringstream& out, const std::string& dataset,
         << Format("%.2f", Mean(wall)) << " | " << Format("%.3g", Median(rot)) << " | "
         << Format("%.3g", Mean(rot)) << " | " << Format("%.3g", Median(trans)) << " | "
         << Format("%.3g", Mean(trans)) << " | " << success << " | "
-        << Format("%.2f", Median(confidence)) << " |\n";
+        << Format("%.2f", Median(confidence)) << " | " << Format("%.2f", Median(first_search))
+        << " | " << retried << " | " << Format("%.1f", retry_s) << " |\n";
   }
 }
 

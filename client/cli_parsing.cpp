@@ -17,16 +17,18 @@ Eigen::Vector3d ParseTriple(const std::string& text, const std::string& flag) {
   while (std::getline(stream, item, ',')) {
     try {
       size_t used = 0;
-      const double value = std::stod(item, &used);
+      const double value = item == "pi" ? (used = item.size(), M_PI) : std::stod(item, &used);
       if (used != item.size() || !std::isfinite(value) || count >= 3)
         throw std::invalid_argument(item);
       values[count++] = value;
     } catch (const std::exception&) {
-      throw InputError(flag + ": expected three comma-separated numbers, got '" + text + "'");
+      throw InputError(flag + ": expected three comma-separated numbers (or pi), got '" + text +
+                       "'");
     }
   }
-  if (count != 3)
-    throw InputError(flag + ": expected three comma-separated numbers, got '" + text + "'");
+  if (count != 3) {
+    throw InputError(flag + ": expected three comma-separated numbers (or pi), got '" + text + "'");
+  }
   return values;
 }
 

@@ -7,7 +7,7 @@
 
 namespace boicp::cli {
 
-/// Parses "a,b,c" into three finite numbers; throws boicp::InputError naming `flag`.
+/// "a,b,c": three finite numbers, each also "pi". Throws InputError naming `flag`.
 Eigen::Vector3d ParseTriple(const std::string& text, const std::string& flag);
 
 /// True when stderr is a terminal (progress may redraw one line).

@@ -30,16 +30,35 @@ nlohmann::json ConfigToJson(const BoIcpConfig& c) {
           {"inlier_distance", c.EffectiveInlierDistance()},
           {"min_range", c.min_range},
           {"max_range", c.max_range},
+          {"retry_when_doubtful", c.retry_when_doubtful},
           {"seed", c.seed},
           {"threads", c.threads}};
 }
 
-nlohmann::json RegistrationToJson(const RegistrationResult& r, const BoIcpConfig& config) {
+nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Attempt& a : attempts) {
+    out.push_back({{"mode", SearchModeName(a.mode)},
+                   {"seed", a.seed},
+                   {"fitness", a.fitness},
+                   {"confidence", a.confidence},
+                   {"evaluations", a.evaluations},
+                   {"runtime_s", a.runtime_s},
+                   {"kept", a.kept}});
+  }
+  return out;
+}
+
+nlohmann::json RegistrationToJson(const RegistrationResult& r,
+                                  const std::vector<std::string>& auto_fields) {
   return {{"transform", TransformToJson(r.transform)},
           {"objective", r.objective},
           {"fitness", r.fitness},
           {"inlier_rmse", r.inlier_rmse},
+          {"overlap", r.overlap},
           {"confidence", r.confidence},
+          {"doubtful", r.doubtful},
+          {"attempts", AttemptsToJson(r.attempts)},
           {"evaluations", r.evaluations},
           {"runtime_s", r.runtime_s},
           {"gp_mean", r.gp_mean},
@@ -47,7 +66,8 @@ nlohmann::json RegistrationToJson(const RegistrationResult& r, const BoIcpConfig
           {"probability_better", r.probability_better},
           {"source_points", r.source_points},
           {"target_points", r.target_points},
-          {"config", ConfigToJson(config)}};
+          {"config", ConfigToJson(r.config)},
+          {"auto", auto_fields}};
 }
 
 }  // namespace boicp::cli

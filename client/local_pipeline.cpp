@@ -13,12 +13,19 @@
 #include "boicp/atomic_file.hpp"
 #include "boicp/map_preview.hpp"
 #include "cli_parsing.hpp"
+#include "json_output.hpp"
 
 namespace boicp::cli {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string joined;
+  for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
+  return joined;
+}
 
 double NowSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -43,14 +50,23 @@ std::string PairName(const PairIndex& p) {
 
 BoIcpConfig BuildConfig(const MapSettings& s) {
   BoIcpConfig config = PresetConfig(s.preset);
-  if (s.voxel) config.voxel = *s.voxel;
+  if (s.fixed_settings) config.automatic.clear();
+  config.mode = ParseSearchMode(s.mode);
+  config.retry_when_doubtful = !s.no_retry;
+  if (s.voxel) {
+    config.voxel = *s.voxel;
+    config.MarkSet("voxel");
+  }
   if (s.random_samples) config.random_samples = *s.random_samples;
   if (s.iterations) config.iterations = *s.iterations;
   if (!s.rotation_bounds.empty()) {
-    config.rotation_bounds = ParseTriple(s.rotation_bounds, "--rotation-bounds");
+    config.rotation_bounds =
+        SnapRotationBounds(ParseTriple(s.rotation_bounds, "--rotation-bounds"));
+    config.MarkSet("rotation_bounds");
   }
   if (!s.translation_bounds.empty()) {
     config.translation_bounds = ParseTriple(s.translation_bounds, "--translation-bounds");
+    config.MarkSet("translation_bounds");
   }
   config.seed = s.seed;
   // Parallelism is across pairs; inside one registration it is one thread,
@@ -75,15 +91,25 @@ ScanFolderOptions FolderOptions(const MapSettings& s) {
 
 }  // namespace
 
+json Nullable(const std::optional<double>& value) { return value ? json(*value) : json(nullptr); }
+
+std::optional<double> NullableFromJson(const json& j, const char* key) {
+  if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
+  return j.at(key).get<double>();
+}
+
 json MapSettingsToJson(const MapSettings& s) {
   return {{"path", s.path},
           {"layout", s.layout},
           {"config", s.preset},
+          {"mode", s.mode},
           {"pairing", s.pairing},
           {"pairs_file", s.pairs_file},
-          {"resolution", s.resolution},
-          {"max_range", s.max_range},
-          {"voxel", s.voxel ? json(*s.voxel) : json(nullptr)},
+          {"resolution", Nullable(s.resolution)},
+          {"max_range", Nullable(s.max_range)},
+          {"fixed_settings", s.fixed_settings},
+          {"no_retry", s.no_retry},
+          {"voxel", Nullable(s.voxel)},
           {"random_samples", s.random_samples ? json(*s.random_samples) : json(nullptr)},
           {"iterations", s.iterations ? json(*s.iterations) : json(nullptr)},
           {"rotation_bounds", s.rotation_bounds},
@@ -106,9 +132,12 @@ MapSettings MapSettingsFromJson(const json& j, const std::string& source) {
     s.preset = j.at("config").get<std::string>();
     s.pairing = j.at("pairing").get<std::string>();
     s.pairs_file = j.at("pairs_file").get<std::string>();
-    s.resolution = j.at("resolution").get<double>();
-    s.max_range = j.at("max_range").get<double>();
-    if (!j.at("voxel").is_null()) s.voxel = j.at("voxel").get<double>();
+    s.mode = j.value("mode", std::string("nested"));
+    s.resolution = NullableFromJson(j, "resolution");
+    s.max_range = NullableFromJson(j, "max_range");
+    s.fixed_settings = j.value("fixed_settings", false);
+    s.no_retry = j.value("no_retry", false);
+    s.voxel = NullableFromJson(j, "voxel");
     if (!j.at("random_samples").is_null()) s.random_samples = j.at("random_samples").get<int>();
     if (!j.at("iterations").is_null()) s.iterations = j.at("iterations").get<int>();
     s.rotation_bounds = j.at("rotation_bounds").get<std::string>();
@@ -152,8 +181,12 @@ LocalRun PrepareRun(const MapSettings& settings) {
   LocalRun run;
   run.settings = settings;
   run.config = BuildConfig(settings);
-  run.map.occupancy.resolution = settings.resolution;
-  run.map.occupancy.max_range = settings.max_range;
+  // Unset map settings keep OccupancySettings' fixed defaults until
+  // ChooseRunSettings replaces them.
+  if (settings.resolution) run.map.occupancy.resolution = *settings.resolution;
+  if (settings.max_range) run.map.occupancy.max_range = *settings.max_range;
+  run.map_auto.resolution = !settings.fixed_settings && !settings.resolution;
+  run.map_auto.max_range = !settings.fixed_settings && !settings.max_range;
   try {
     ValidateOccupancySettings(run.map.occupancy);
   } catch (const InputError& e) {
@@ -183,6 +216,32 @@ LocalRun PrepareRun(const MapSettings& settings) {
                      "' is not consecutive, overlap or explicit");
   }
   return run;
+}
+
+void ChooseRunSettings(LocalRun& run) {
+  run.auto_fields =
+      ApplyBatchSettings(run.folder.scans, run.config, run.map.occupancy, run.map_auto);
+  run.map_auto = {false, false};
+  ValidateConfig(run.config);
+  ValidateOccupancySettings(run.map.occupancy);
+  std::fprintf(
+      stderr,
+      "settings: voxel %.3g m, refine voxel %.3g m, translation bounds %.3g,%.3g,%.3g m, "
+      "rotation bounds %.3g,%.3g,%.3g rad, map resolution %.3g m, ray length %.3g m%s%s\n",
+      run.config.voxel, run.config.EffectiveRefineVoxel(), run.config.translation_bounds[0],
+      run.config.translation_bounds[1], run.config.translation_bounds[2],
+      run.config.rotation_bounds[0], run.config.rotation_bounds[1], run.config.rotation_bounds[2],
+      run.map.occupancy.resolution, run.map.occupancy.max_range,
+      run.auto_fields.empty() ? "" : "; from the scans: ", JoinNames(run.auto_fields).c_str());
+}
+
+json RunManifestJson(const LocalRun& run) {
+  json manifest = MapSettingsToJson(run.settings);
+  manifest["chosen"] = ConfigToJson(run.config);
+  manifest["chosen"]["map_resolution"] = run.map.occupancy.resolution;
+  manifest["chosen"]["map_max_range"] = run.map.occupancy.max_range;
+  manifest["auto"] = run.auto_fields;
+  return manifest;
 }
 
 PairProgress::PairProgress(int total)

@@ -26,12 +26,15 @@ struct MapSettings {
   std::string preset = "C";
   std::string pairing = "consecutive";  // consecutive | overlap | explicit
   std::string pairs_file;               // explicit pairing: "source,target" lines
-  double resolution = 0.2;              // OctoMap leaf, metres
-  double max_range = 0.0;               // OctoMap ray cut, metres; 0 = none
-  std::optional<double> voxel;          // search voxel override, metres
+  std::string mode = "nested";          // nested | 6dof
+  // OctoMap leaf and ray cut, metres (ray cut 0 = none); unset = from the scans.
+  std::optional<double> resolution, max_range;
+  std::optional<double> voxel;  // search voxel override, metres; unset = from the scans
   // N_r and N per search stage; unset = the preset's.
   std::optional<int> random_samples, iterations;
-  std::string rotation_bounds, translation_bounds;  // "a,b,c" overrides; empty = preset's
+  std::string rotation_bounds, translation_bounds;  // "a,b,c" overrides; empty = from the scans
+  bool fixed_settings = false;  // the preset's fixed voxel, bounds and map settings
+  bool no_retry = false;        // never search a doubtful pair again
   uint64_t seed = 1;
   int first = 0, stride = 1, count = 0;
   std::string intrinsics;  // "fx,fy,cx,cy"
@@ -50,14 +53,24 @@ struct LocalRun {
   ScanFolder folder;
   BoIcpConfig config;  // config.seed is the job seed; one thread per registration
   MapBuildSettings map;
-  bool keyframes = false;        // overlap pairing
-  double overlap_threshold = 0;  // keyframes only
-  std::vector<PairIndex> plan;   // consecutive or explicit pairs; empty for keyframes
+  MapAutoFields map_auto;                // map settings still to be chosen from the scans
+  std::vector<std::string> auto_fields;  // the settings ChooseRunSettings chose
+  bool keyframes = false;                // overlap pairing
+  double overlap_threshold = 0;          // keyframes only
+  std::vector<PairIndex> plan;           // consecutive or explicit pairs; empty for keyframes
 };
 
 /// Reads the folder and validates everything (config, map settings,
 /// pairs). Scans are not loaded. Throws InputError naming the field or file.
 LocalRun PrepareRun(const MapSettings& settings);
+
+/// Chooses the settings the user left automatic from the run's scans
+/// (ApplyBatchSettings), once for the whole run, and prints them on stderr.
+void ChooseRunSettings(LocalRun& run);
+
+/// run.json: the settings as given, plus "chosen" (the settings used) and
+/// "auto" (which of them came from the scans).
+nlohmann::json RunManifestJson(const LocalRun& run);
 
 /// "source,target" index pairs, one a line ('#' comments, blank lines and a
 /// "source,target" header skipped). Throws InputError naming file and line.

@@ -78,7 +78,7 @@ void ClaimShardManifest(const LocalRun& run, const std::string& out) {
     return;
   }
   fs::create_directories(out);
-  WriteTextFileAtomically(manifest, MapSettingsToJson(run.settings).dump(1) + "\n");
+  WriteTextFileAtomically(manifest, RunManifestJson(run).dump(1) + "\n");
 }
 
 // A shard registers the pairs whose index in the plan is K-1 modulo N and
@@ -116,7 +116,7 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
              std::chrono::steady_clock::time_point start) {
   const std::string& out = flags.out_dir;
   fs::create_directories(out);
-  WriteTextFileAtomically(RunManifestPath(out), MapSettingsToJson(run.settings).dump(1) + "\n");
+  WriteTextFileAtomically(RunManifestPath(out), RunManifestJson(run).dump(1) + "\n");
 
   int reused = 0;
   std::vector<PairIndex> chain_pairs = run.plan;
@@ -172,7 +172,7 @@ int RunMap(MapFlags flags) {
     MapSettings settings = ResolveMapSettings(flags.map);
     settings.path = Absolute(settings.path);
     settings.pairs_file = Absolute(settings.pairs_file);
-    const LocalRun run = PrepareRun(settings);
+    LocalRun run = PrepareRun(settings);
     const std::string& out = flags.out_dir;
     const std::optional<Shard> shard =
         flags.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(flags.shard));
@@ -181,9 +181,10 @@ int RunMap(MapFlags flags) {
           "--shard: overlap pairing chooses its pairs as results come in; shard "
           "consecutive or explicit pairing");
     }
-    if (shard) ClaimShardManifest(run, out);
     CheckScansLoad(run.folder);
     std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
+    ChooseRunSettings(run);
+    if (shard) ClaimShardManifest(run, out);
     if (shard) return RunShard(run, *shard, flags);
     return BuildMap(run, flags, start);
   } catch (const InputError& e) {

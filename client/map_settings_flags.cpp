@@ -12,16 +12,22 @@ void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags) {
                  "'source,target' scan indices)")
       ->expected(1, -1)
       ->default_str("consecutive");
-  app.add_option("--resolution", s.resolution, "OctoMap leaf size (m)")->capture_default_str();
-  app.add_option("--max-range", s.max_range, "OctoMap ray length (m); 0 = no limit")
+  app.add_option("--mode", s.mode, "nested (rotation then translation) or 6dof")
       ->capture_default_str();
-  app.add_option("--voxel", s.voxel, "Search voxel (m); default: the preset's");
+  app.add_option("--resolution", s.resolution, "OctoMap leaf size (m); default: from the scans");
+  app.add_option("--max-range", s.max_range,
+                 "OctoMap ray length (m), 0 = no limit; default: from the scans");
+  app.add_option("--voxel", s.voxel, "Search voxel (m); default: from the scans");
   app.add_option("--random-samples", s.random_samples,
                  "N_r per search stage; default: the preset's");
   app.add_option("--iterations", s.iterations, "N per search stage; default: the preset's");
   app.add_option("--rotation-bounds", s.rotation_bounds,
-                 "Half-widths roll,pitch,yaw (rad); ground vehicles: 0.2,0.2,3.14159");
-  app.add_option("--translation-bounds", s.translation_bounds, "Half-widths x,y,z (m)");
+                 "Half-widths roll,pitch,yaw (rad, or pi); default: from the sensor");
+  app.add_option("--translation-bounds", s.translation_bounds,
+                 "Half-widths x,y,z (m); default: from the scans");
+  app.add_flag("--fixed-settings", s.fixed_settings,
+               "The preset's fixed voxel, bounds and map settings instead of choosing them");
+  app.add_flag("--no-retry", s.no_retry, "Never search a doubtful pair again");
   app.add_option("--seed", s.seed, "Job seed; each pair's seed derives from it")
       ->capture_default_str();
   app.add_option("--first", s.first, "Index of the first scan kept")->capture_default_str();

@@ -37,11 +37,12 @@ MapSettings AgreedManifest(const std::vector<std::string>& dirs) {
 
 int RunMerge(const MergeFlags& flags) {
   try {
-    const LocalRun run = PrepareRun(AgreedManifest(flags.shard_dirs));
+    LocalRun run = PrepareRun(AgreedManifest(flags.shard_dirs));
     if (run.keyframes) {
       throw InputError(RunManifestPath(flags.shard_dirs.front()) +
                        ": overlap pairing is not sharded; run boicp map instead");
     }
+    ChooseRunSettings(run);  // the shards' own choice: the same scans give the same settings
     const std::map<PairIndex, PairRecord> records =
         ReadStoredPairs(run, run.plan, flags.shard_dirs);
     CheckScansLoad(run.folder);
@@ -50,8 +51,7 @@ int RunMerge(const MergeFlags& flags) {
     std::vector<PairRecord> chain;
     for (const PairIndex& p : run.plan) chain.push_back(records.at(p));
     fs::create_directories(flags.out_dir);
-    WriteTextFileAtomically(RunManifestPath(flags.out_dir),
-                            MapSettingsToJson(run.settings).dump(1) + "\n");
+    WriteTextFileAtomically(RunManifestPath(flags.out_dir), RunManifestJson(run).dump(1) + "\n");
     const MapOutputSummary summary = WriteMapOutputs(run, chain, chain, flags.out_dir);
     std::fprintf(stderr,
                  "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"

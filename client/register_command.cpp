@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "boicp/auto_settings.hpp"
 #include "boicp/bo_icp.hpp"
 #include "boicp/point_cloud_io.hpp"
 #include "cli_parsing.hpp"
@@ -27,20 +28,28 @@ struct RegisterFlags {
   std::optional<size_t> evaluation_points;
   std::optional<size_t> coarse_icp_points;
   uint64_t seed = 1;
-  // One thread by default: splitting each ICP iteration across threads pays
-  // only on an idle machine (config C on the demo pair, busy 2-core box: 79 s with 2 threads, 8 s
-  // with 1).
   int threads = 1;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, fixed_settings = false, no_retry = false;
 };
 
 BoIcpConfig BuildConfig(const RegisterFlags& f) {
   BoIcpConfig config = PresetConfig(f.preset);
+  if (f.fixed_settings) config.automatic.clear();
   config.mode = ParseSearchMode(f.mode);
-  if (f.voxel) config.voxel = *f.voxel;
-  if (f.refine_voxel) config.refine_voxel = *f.refine_voxel;
+  config.retry_when_doubtful = !f.no_retry;
+  if (f.voxel) {
+    config.voxel = *f.voxel;
+    config.MarkSet("voxel");
+  }
+  if (f.refine_voxel) {
+    config.refine_voxel = *f.refine_voxel;
+    config.MarkSet("refine_voxel");
+  }
   if (f.max_correspondence) config.max_correspondence_distance = *f.max_correspondence;
-  if (f.truncation) config.objective_truncation = *f.truncation;
+  if (f.truncation) {
+    config.objective_truncation = *f.truncation;
+    config.MarkSet("objective_truncation");
+  }
   if (f.icp_iterations) config.icp_max_iterations = *f.icp_iterations;
   if (f.min_range) config.min_range = *f.min_range;
   if (f.max_range) config.max_range = *f.max_range;
@@ -50,9 +59,12 @@ BoIcpConfig BuildConfig(const RegisterFlags& f) {
   if (f.coarse_icp_points) config.coarse_icp_points = *f.coarse_icp_points;
   if (!f.translation_bounds.empty()) {
     config.translation_bounds = ParseTriple(f.translation_bounds, "--translation-bounds");
+    config.MarkSet("translation_bounds");
   }
   if (!f.rotation_bounds.empty()) {
-    config.rotation_bounds = ParseTriple(f.rotation_bounds, "--rotation-bounds");
+    config.rotation_bounds =
+        SnapRotationBounds(ParseTriple(f.rotation_bounds, "--rotation-bounds"));
+    config.MarkSet("rotation_bounds");
   }
   config.seed = f.seed;
   config.threads = f.threads;
@@ -101,32 +113,35 @@ void PrintHuman(const RegistrationResult& r) {
   std::cout << std::setprecision(4) << "objective   " << r.objective << " m\n"
             << "fitness     " << r.fitness << "\n"
             << "inlier_rmse " << r.inlier_rmse << " m\n"
-            << "confidence  " << r.confidence << "\n"
+            << "confidence  " << r.confidence << (r.doubtful ? " (doubtful)" : "") << "\n"
+            << "searches    " << r.attempts.size() << "\n"
             << "evaluations " << r.evaluations << "\n"
             << "runtime     " << r.runtime_s << " s\n";
 }
 
 int RunRegister(const RegisterFlags& flags) {
   try {
-    const BoIcpConfig config = BuildConfig(flags);
+    BoIcpConfig config = BuildConfig(flags);
     const LoadOptions load = BuildLoadOptions(flags);
     const LoadedCloud source = LoadPointCloud(flags.source, load);
     const LoadedCloud target = LoadPointCloud(flags.target, load);
     std::optional<Transform> prior;
     if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
+    const ChosenSettings chosen =
+        ChooseSettingsForClouds({&source.points, &target.points}, source.format, config.seed);
+    const std::vector<std::string> auto_fields = ApplyChosenSettings(chosen, config);
+    ValidateConfig(config);
     if (!flags.quiet) {
       std::fprintf(stderr,
                    "loaded %zu source and %zu target points (%zu and %zu non-finite dropped)\n",
                    source.points.size(), target.points.size(), source.dropped_nonfinite,
                    target.dropped_nonfinite);
-      std::fprintf(stderr, "preset %s, %s search, voxel %.3f m, %d threads, seed %llu\n",
-                   config.preset.c_str(), SearchModeName(config.mode).c_str(), config.voxel,
-                   config.threads, static_cast<unsigned long long>(config.seed));
+      std::fprintf(stderr, "%s\n", DescribeSettings(config, auto_fields, chosen.sensor).c_str());
     }
     const RegistrationResult result =
         RegisterPair(source.points, target.points, config, prior, MakeProgressPrinter(flags.quiet));
     if (flags.json) {
-      std::cout << RegistrationToJson(result, config).dump() << std::endl;
+      std::cout << RegistrationToJson(result, auto_fields).dump() << std::endl;
     } else {
       PrintHuman(result);
     }
@@ -152,9 +167,12 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--seed", f.seed, "Seed for every random choice")->capture_default_str();
   app.add_flag("--json", f.json, "Print one JSON object on stdout");
+  app.add_flag("--fixed-settings", f.fixed_settings,
+               "Use the preset's fixed voxel and bounds instead of choosing them from the clouds");
+  app.add_flag("--no-retry", f.no_retry, "Do not search again when the answer is doubtful");
   app.add_flag("-q,--quiet", f.quiet, "No progress on stderr");
   app.add_option("--threads", f.threads,
-                 "ICP runs of one BO round at once (the answer does not depend on it)")
+                 "Threads for the search and the refinement (the answer does not depend on it)")
       ->capture_default_str();
   app.add_option("--format", f.format, "auto, kitti, pcd, ply, xyz or depth")
       ->capture_default_str();
@@ -166,16 +184,18 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--prior", f.prior_file, "Initial guess: file with a 4x4 or 3x4 T_target_source");
-  app.add_option("--voxel", f.voxel, "Search voxel size (metres)");
+  app.add_option("--voxel", f.voxel, "Search voxel size (metres; default: from the clouds)");
   app.add_option("--refine-voxel", f.refine_voxel,
-                 "Final ICP voxel size (metres; default voxel/4)");
+                 "Final ICP voxel size (metres; default: from the clouds)");
   app.add_option("--max-correspondence", f.max_correspondence,
                  "ICP correspondence gate during the search (metres; default 3 x voxel)");
   app.add_option("--objective-truncation", f.truncation,
                  "Clipping distance of the search objective (metres; default 1.5 x voxel)");
   app.add_option("--icp-iterations", f.icp_iterations, "ICP iterations per evaluation");
-  app.add_option("--translation-bounds", f.translation_bounds, "Half-widths X,Y,Z (metres)");
-  app.add_option("--rotation-bounds", f.rotation_bounds, "Half-widths roll,pitch,yaw (radians)");
+  app.add_option("--translation-bounds", f.translation_bounds,
+                 "Half-widths X,Y,Z (metres; default: from the clouds)");
+  app.add_option("--rotation-bounds", f.rotation_bounds,
+                 "Half-widths roll,pitch,yaw (radians, or pi; default: from the sensor)");
   app.add_option("--random-samples", f.random_samples, "N_r: initial samples per stage");
   app.add_option("--iterations", f.iterations, "N: BO iterations per stage");
   app.add_option("--evaluation-points", f.evaluation_points,

@@ -1,26 +1,67 @@
 #include "remote_json.hpp"
 
+#include <cstdio>
+
 #include "json_output.hpp"
 
 namespace boicp::cli {
 
+nlohmann::json ChosenSettingsToJson(const v1::ChosenSettings& s) {
+  const v1::RegistrationConfig& c = s.config();
+  const auto triple = [](const v1::Vector3& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+  return {{"preset", c.preset()},
+          {"mode", c.mode()},
+          {"voxel", c.voxel()},
+          {"refine_voxel", c.refine_voxel()},
+          {"rotation_bounds", triple(c.rotation_bounds())},
+          {"translation_bounds", triple(c.translation_bounds())},
+          {"random_samples", c.random_samples()},
+          {"iterations", c.iterations()},
+          {"retry_when_doubtful", !c.no_retry()},
+          {"seed", c.seed()},
+          {"map_resolution", s.map_resolution()},
+          {"map_max_range", s.map_max_range()},
+          {"auto", s.auto_fields()}};
+}
+
+std::string DescribeChosenSettings(const v1::ChosenSettings& s) {
+  const v1::RegistrationConfig& c = s.config();
+  std::string automatic;
+  for (const std::string& field : s.auto_fields()) {
+    automatic += (automatic.empty() ? "" : ", ") + field;
+  }
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "preset %s, %s, voxel %.3g m, refine voxel %.3g m, translation bounds "
+                "%.3g,%.3g,%.3g m, rotation bounds %.3g,%.3g,%.3g rad, map resolution %.3g m, "
+                "ray length %.3g m%s%s",
+                c.preset().c_str(), c.mode().c_str(), c.voxel(), c.refine_voxel(),
+                c.translation_bounds().x(), c.translation_bounds().y(), c.translation_bounds().z(),
+                c.rotation_bounds().x(), c.rotation_bounds().y(), c.rotation_bounds().z(),
+                s.map_resolution(), s.map_max_range(),
+                automatic.empty() ? "" : "; from the scans: ", automatic.c_str());
+  return text;
+}
+
 nlohmann::json JobToJson(const v1::Job& job) {
-  return {{"job_id", job.job_id()},
-          {"label", job.label()},
-          {"state", JobStateName(job.state())},
-          {"stage", job.stage()},
-          {"pairs_done", job.pairs_done()},
-          {"pairs_total", job.pairs_total()},
-          {"num_scans", job.num_scans()},
-          {"stage_done", job.stage_done()},
-          {"stage_total", job.stage_total()},
-          {"eta_seconds", job.eta_seconds()},
-          {"created_at", job.created_at()},
-          {"started_at", job.started_at()},
-          {"finished_at", job.finished_at()},
-          {"error", job.error()},
-          {"cancel_requested", job.cancel_requested()},
-          {"pose_graph_optimised", job.pose_graph_optimised()}};
+  return {
+      {"job_id", job.job_id()},
+      {"label", job.label()},
+      {"state", JobStateName(job.state())},
+      {"stage", job.stage()},
+      {"pairs_done", job.pairs_done()},
+      {"pairs_total", job.pairs_total()},
+      {"num_scans", job.num_scans()},
+      {"stage_done", job.stage_done()},
+      {"stage_total", job.stage_total()},
+      {"eta_seconds", job.eta_seconds()},
+      {"created_at", job.created_at()},
+      {"started_at", job.started_at()},
+      {"finished_at", job.finished_at()},
+      {"error", job.error()},
+      {"cancel_requested", job.cancel_requested()},
+      {"pose_graph_optimised", job.pose_graph_optimised()},
+      {"settings", job.has_settings() ? ChosenSettingsToJson(job.settings()) : nlohmann::json()}};
 }
 
 nlohmann::json PairToJson(const v1::PairResult& pair) {

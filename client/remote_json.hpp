@@ -3,6 +3,8 @@
 // `show --json`. Field names follow the proto (snake_case); states are
 // lowercase words; transforms are 4x4 row-major nested arrays.
 
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "remote_proto.hpp"
@@ -13,6 +15,13 @@ namespace boicp::cli {
 ///  "num_scans", "stage_done", "stage_total", "eta_seconds", "created_at",
 ///  "started_at", "finished_at", "error", "cancel_requested",
 ///  "pose_graph_optimised"}; times are Unix seconds (0 = not yet).
+/// A job's chosen settings: the config fields, map_resolution, map_max_range
+/// and "auto" (the names of the fields chosen from the scans).
+nlohmann::json ChosenSettingsToJson(const v1::ChosenSettings& settings);
+
+/// The same on one line, for `boicp show`.
+std::string DescribeChosenSettings(const v1::ChosenSettings& settings);
+
 nlohmann::json JobToJson(const v1::Job& job);
 
 /// {"source", "target", "source_scan_id", "target_scan_id", "transform"

@@ -32,6 +32,8 @@ void PrintSummary(const v1::JobResults& results) {
                 job.finished_at() > 0.0 ? "" : " so far");
   }
   if (!job.error().empty()) std::printf("error       %s\n", job.error().c_str());
+  if (job.has_settings())
+    std::printf("settings    %s\n", DescribeChosenSettings(job.settings()).c_str());
   if (results.pairs_size() == 0) return;
   // T_target_source summarised by its translation and rotation angle.
   std::printf("\n%6s %6s %8s %10s %11s %8s %7s %9s %9s %5s\n", "source", "target", "fitness",

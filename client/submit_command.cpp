@@ -63,8 +63,16 @@ v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
     SetVector(run.config.translation_bounds, config.mutable_translation_bounds());
   }
   config.set_seed(s.seed);
-  request.mutable_map()->set_resolution(run.map.occupancy.resolution);
-  request.mutable_map()->set_max_range(run.map.occupancy.max_range);
+  config.set_mode(s.mode);
+  config.set_fixed_settings(s.fixed_settings);
+  config.set_no_retry(s.no_retry);
+  // Unset map settings are chosen by the daemon from the uploaded scans.
+  if (s.resolution || s.fixed_settings) {
+    request.mutable_map()->set_resolution(run.map.occupancy.resolution);
+  }
+  if (s.max_range || s.fixed_settings) {
+    request.mutable_map()->set_max_range(run.map.occupancy.max_range);
+  }
   request.set_label(f.label.empty() ? s.path : f.label);
   return request;
 }

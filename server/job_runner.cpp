@@ -81,6 +81,10 @@ class JobRun {
                          ctx_.registration_threads);
     num_scans_ = static_cast<int>(spec_.scans.size());
     VerifyScans();
+    // Chosen once from the job's scans; a resumed job chooses the same again.
+    const std::vector<std::string> auto_fields =
+        ApplyBatchSettings(spec_.scans, spec_.config, spec_.map.occupancy, spec_.map_auto);
+    *job_.mutable_settings() = ChosenSettingsToProto(spec_.config, spec_.map, auto_fields);
     for (StoredPair& stored : ctx_.store.GetPairs(job_.job_id())) {
       results_[IndexOf(stored.result)] = std::move(stored);
     }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "boicp/batch_pair.hpp"
 #include "boicp/config.hpp"
 #include "boicp/map_assembly.hpp"
 #include "boicp/map_pairs.hpp"
@@ -29,6 +30,7 @@ struct JobSpec {
   std::vector<PairIndex> extra_pairs;  // loop closures on top of the policy's pairs
   BoIcpConfig config;                  // config.seed is the job seed
   MapBuildSettings map;
+  MapAutoFields map_auto;  // map settings still to be chosen from the scans
 };
 
 /// Preset plus overrides, validated. `threads` is the daemon's setting for
@@ -37,6 +39,11 @@ BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads);
 
 /// Map settings with defaults for zero fields, validated. Throws InputError.
 MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto);
+
+/// The settings a job runs with, for its record: `config` and `map` as
+/// resolved, and the names of the fields chosen from the scans.
+v1::ChosenSettings ChosenSettingsToProto(const BoIcpConfig& config, const MapBuildSettings& map,
+                                         const std::vector<std::string>& auto_fields);
 
 /// Validates everything about a batch except that its scans exist (the
 /// caller looked them up to get `scans`). Throws InputError naming the field.

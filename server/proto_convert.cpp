@@ -38,6 +38,14 @@ void TransformToProto(const Transform& T, v1::Transform* proto) {
   for (int i = 0; i < 16; ++i) proto->add_m(T(i / 4, i % 4));
 }
 
+v1::Vector3 PointToProto(const Point& point) {
+  v1::Vector3 out;
+  out.set_x(point.x());
+  out.set_y(point.y());
+  out.set_z(point.z());
+  return out;
+}
+
 Point PointFromProto(const v1::Vector3& proto, const std::string& field) {
   const Point p(proto.x(), proto.y(), proto.z());
   if (!p.allFinite()) throw InputError(field + ": non-finite value");

@@ -20,6 +20,7 @@ void TransformToProto(const Transform& T, v1::Transform* proto);
 
 /// Throws InputError naming `field` unless all three are finite.
 Point PointFromProto(const v1::Vector3& proto, const std::string& field);
+v1::Vector3 PointToProto(const Point& point);
 
 /// Throws InputError for SCAN_FORMAT_UNSPECIFIED or a value this daemon does not know.
 CloudFormat FormatFromProto(int format);

@@ -1,5 +1,7 @@
 #include "boicp/batch_pair.hpp"
 
+#include <algorithm>
+
 #include "boicp/voxel_cloud.hpp"
 
 namespace boicp {
@@ -42,6 +44,36 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
       PairInformation(Downsample(source_points, voxel), Downsample(target_points, voxel),
                       out.registration.transform, config.EffectiveInlierDistance());
   return out;
+}
+
+std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans,
+                                            BoIcpConfig& config, OccupancySettings& occupancy,
+                                            const MapAutoFields& map_auto) {
+  if (scans.empty()) throw InputError("a batch needs at least one scan");
+  if (config.automatic.empty() && !map_auto.resolution && !map_auto.max_range) return {};
+  constexpr size_t kSampledScans = 5;
+  const size_t count = std::min(kSampledScans, scans.size());
+  std::vector<Points> clouds;
+  CloudFormat format = CloudFormat::kAuto;
+  for (size_t k = 0; k < count; ++k) {
+    const size_t index = count == 1 ? 0 : k * (scans.size() - 1) / (count - 1);
+    LoadedCloud loaded = LoadPointCloud(scans[index].path, scans[index].load);
+    format = loaded.format;
+    clouds.push_back(std::move(loaded.points));
+  }
+  std::vector<const Points*> pointers;
+  for (const Points& cloud : clouds) pointers.push_back(&cloud);
+  const ChosenSettings chosen = ChooseSettingsForClouds(pointers, format, config.seed, count);
+  std::vector<std::string> set = ApplyChosenSettings(chosen, config);
+  if (map_auto.resolution) {
+    occupancy.resolution = chosen.map_resolution;
+    set.push_back("map_resolution");
+  }
+  if (map_auto.max_range) {
+    occupancy.max_range = chosen.map_max_range;
+    set.push_back("map_max_range");
+  }
+  return set;
 }
 
 double BatchOverlapThreshold(const std::vector<ScanSource>& scans) {

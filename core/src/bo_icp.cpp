@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "boicp/alignment_score.hpp"
+#include "boicp/auto_settings.hpp"
 #include "boicp/icp.hpp"
 #include "boicp/nearest_neighbors.hpp"
 #include "boicp/preprocess.hpp"
@@ -52,16 +53,9 @@ class Search {
     std::mutex mutex;
     std::vector<Finished> finished;
     size_t committed = 0;  // entries of `finished` whose ends are in known_ends_
-    // Only translation-only stages abandon hopeless starts: a start that must
-    // rotate slides slowly and then snaps into its basin, so its recent
-    // progress says little about where it ends (measured on 7-Scenes:
-    // abandoning in the rotation stage lost the true basin on 1 of 4 pairs).
-    const bool may_abandon = config_.abandon_hopeless && !space.SearchesRotation();
-    const BoundedObjective objective = [&](const Eigen::VectorXd& u, double incumbent) {
+    const BoundedObjective objective = [&](const Eigen::VectorXd& u, double /*incumbent*/) {
       bool converged = false;
-      const Evaluation evaluation =
-          Evaluate(stage, space.ToTransform(u),
-                   may_abandon ? incumbent : std::numeric_limits<double>::infinity(), converged);
+      const Evaluation evaluation = Evaluate(stage, space.ToTransform(u), converged);
       const std::lock_guard<std::mutex> lock(mutex);
       finished.push_back({u, evaluation, converged});
       return evaluation.objective;
@@ -95,20 +89,16 @@ class Search {
 
  private:
   // The paper's objective: the error ICP reaches when started from T0. Runs
-  // that cannot get below `abandon_above` are abandoned early; runs that reach
-  // the end of an earlier run take over its result. `converged` tells whether
-  // the run found an end of its own.
-  Evaluation Evaluate(int stage, const Transform& initial, double abandon_above,
-                      bool& converged) const {
+  // that reach the end of an earlier run take over its result. `converged`
+  // tells whether the run found an end of its own.
+  Evaluation Evaluate(int stage, const Transform& initial, bool& converged) const {
     const NearestNeighborIndex& target = pair_.prepared.search_target;
-    Evaluation evaluation{stage, initial, initial, 0.0, false};
+    Evaluation evaluation{stage, initial, initial, 0.0};
     converged = false;
     if (callbacks_.local_icp) {
       evaluation.result = callbacks_.local_icp(pair_.evaluation_source, target.points(), initial);
     } else {
       IcpOptions options = pair_.search_icp;
-      options.abandon_above = abandon_above;
-      options.truncation = config_.EffectiveTruncation();
       IcpResult icp;
       icp.transform = initial;
       if (pair_.coarse_source.size() < pair_.evaluation_source.size()) {
@@ -116,12 +106,11 @@ class Search {
         options.max_iterations =
             std::max(options.max_iterations - icp.iterations, config_.finish_icp_iterations);
       }
-      if (icp.joined_end < 0 && !icp.abandoned) {
+      if (icp.joined_end < 0) {
         icp =
             AlignPointToPoint(pair_.evaluation_source, target, icp.transform, options, known_ends_);
       }
       evaluation.result = icp.transform;
-      evaluation.abandoned = icp.abandoned;
       if (icp.joined_end >= 0) {
         evaluation.objective = known_objectives_[icp.joined_end];
         return evaluation;
@@ -168,8 +157,12 @@ Eigen::VectorXd TranslationToUnit(const SearchSpace& space, const Eigen::Vector3
   return u;
 }
 
-// The best search results that ended in different places (more than 5 degrees
-// or 3 voxels apart), best first, at most `count`.
+bool SameBasin(const Transform& a, const Transform& b, double voxel) {
+  const Transform delta = a.inverse() * b;
+  return RotationAngle(delta) < 5.0 * M_PI / 180.0 && TranslationNorm(delta) < 3.0 * voxel;
+}
+
+// The best search results that ended in different basins, best first, at most `count`.
 std::vector<Evaluation> DistinctBest(std::vector<Evaluation> history, int count, double voxel) {
   std::sort(history.begin(), history.end(),
             [](const Evaluation& a, const Evaluation& b) { return a.objective < b.objective; });
@@ -177,22 +170,41 @@ std::vector<Evaluation> DistinctBest(std::vector<Evaluation> history, int count,
   for (const Evaluation& e : history) {
     if (static_cast<int>(picked.size()) >= count) break;
     const bool repeats = std::any_of(picked.begin(), picked.end(), [&](const Evaluation& p) {
-      const Transform delta = p.result.inverse() * e.result;
-      return RotationAngle(delta) < 5.0 * M_PI / 180.0 && TranslationNorm(delta) < 3.0 * voxel;
+      return SameBasin(p.result, e.result, voxel);
     });
     if (!repeats) picked.push_back(e);
   }
   return picked;
 }
 
-}  // namespace
+// Share of the first stage's runs (the ones that started from anywhere in
+// the box) that ended in the basin of `answer`.
+double BasinSupport(const std::vector<Evaluation>& history, const Transform& answer, double voxel) {
+  int first_stage = 0, in_basin = 0;
+  for (const Evaluation& e : history) {
+    if (e.stage != 0) continue;
+    ++first_stage;
+    in_basin += SameBasin(answer, e.result, voxel) ? 1 : 0;
+  }
+  return first_stage > 0 ? static_cast<double>(in_basin) / first_stage : 0.0;
+}
 
-RegistrationResult RegisterPair(const Points& source, const Points& target,
-                                const BoIcpConfig& config, const std::optional<Transform>& prior,
-                                const RegistrationCallbacks& callbacks) {
-  const auto started = std::chrono::steady_clock::now();
-  ValidateConfig(config);
+// One search (nested or 6 DOF) and the refinement of its distinct best ends.
+struct SearchOutcome {
+  RefinedAlignment refined;
+  double overlap = 0.0;  // RegistrationResult::overlap of the refined answer
+  size_t source_points = 0, target_points = 0;
+  double objective = 0.0;  // best search objective
+  double probability_better = 0.0;
+  double gp_mean = 0.0, gp_std = 0.0;
+  std::vector<Evaluation> history;
+  ConfidenceFeatures features;
+  double confidence = 0.0;
+};
 
+SearchOutcome SearchAndRefine(const Points& source, const Points& target, const BoIcpConfig& config,
+                              const std::optional<Transform>& prior,
+                              const RegistrationCallbacks& callbacks) {
   const PreparedPair prepared = PreparePair(source, target, config);
   Points evaluation_source = RandomSubsample(prepared.search_source, config.evaluation_points,
                                              config.seed ^ kSubsampleSalt);
@@ -214,7 +226,7 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
       anchor.topLeftCorner<3, 3>() * Centroid(search_source) + anchor.topRightCorner<3, 1>();
 
   Search search(pair, config, callbacks);
-  RegistrationResult result;
+  SearchOutcome out;
   BayesOptResult last;
   if (config.mode == SearchMode::kNested) {
     const BayesOptResult rotation = search.RunStage(
@@ -232,42 +244,114 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
         MakeSearchSpace(centred, pivot, Eigen::Vector3d::Zero(), config.translation_bounds);
     last = search.RunStage(1, translation, "translation",
                            {TranslationToUnit(translation, rotated.topRightCorner<3, 1>())});
-    result.probability_better = std::max(rotation.probability_better, last.probability_better);
+    out.probability_better = std::max(rotation.probability_better, last.probability_better);
   } else {
     last = search.RunStage(
         0, MakeSearchSpace(anchor, pivot, config.rotation_bounds, config.translation_bounds),
         "6dof");
-    result.probability_better = last.probability_better;
+    out.probability_better = last.probability_better;
   }
-  const Evaluation best = search.Best();
+  out.objective = search.Best().objective;
 
   // The search objective is measured on coarse voxels; a few distinct
-  // candidates are refined and the one that fits best at the finest level wins.
+  // candidates are refined and compared at the finest level.
   std::vector<Transform> candidates;
   for (const Evaluation& e : DistinctBest(search.history(), config.refine_candidates, config.voxel))
     candidates.push_back(e.result);
-  if (callbacks.progress) callbacks.progress({"refine", 0, 1, best.objective});
-  const RefinedAlignment final_alignment = RefineCoarseToFine(candidates, prepared, config);
-  if (callbacks.progress) callbacks.progress({"refine", 1, 1, best.objective});
+  if (callbacks.progress) callbacks.progress({"refine", 0, 1, out.objective});
+  out.refined = RefineCoarseToFine(candidates, pair.prepared, config);
+  if (callbacks.progress) callbacks.progress({"refine", 1, 1, out.objective});
 
-  result.transform = final_alignment.transform;
-  result.objective = best.objective;
-  result.fitness = final_alignment.score.fitness;
-  result.inlier_rmse = final_alignment.score.inlier_rmse;
-  result.overlap = ScoreAlignment(search_source, prepared.search_target, result.transform,
-                                  1.5 * config.voxel, config.threads)
-                       .fitness;
-  result.confidence = result.fitness * (1.0 - result.probability_better);
+  out.gp_mean = last.gp_mean_at_best;
+  out.gp_std = last.gp_std_at_best;
+  out.history = std::move(search.history());
+  out.features.fitness = out.refined.score.fitness;
+  out.features.rmse_ratio = out.refined.score.inlier_rmse / config.EffectiveInlierDistance();
+  out.features.margin = out.refined.margin;
+  out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
+  out.features.probability_better = out.probability_better;
+  out.confidence = Confidence(out.features);
+  out.overlap = ScoreAlignment(search_source, prepared.search_target, out.refined.transform,
+                               1.5 * config.voxel, config.threads)
+                    .fitness;
+  out.source_points = search_source.size();
+  out.target_points = prepared.search_target.size();
+  return out;
+}
+
+// The seed of a retry: another stream of the same job seed.
+uint64_t RetrySeed(uint64_t seed) { return seed ^ 0xa0761d6478bd642fULL; }
+
+// The retry of a doubtful search: in 6 DOF, with another seed, and at
+// config.retry_voxel when set. The finest refinement level stays, so both
+// answers' fitness is measured alike.
+BoIcpConfig RetryConfig(const BoIcpConfig& config) {
+  BoIcpConfig retry = config;
+  retry.mode = SearchMode::kSixDof;
+  retry.seed = RetrySeed(config.seed);
+  if (config.retry_voxel > 0.0) {
+    const double scale = config.retry_voxel / config.voxel;
+    retry.refine_voxel = config.EffectiveRefineVoxel();
+    retry.objective_truncation = config.EffectiveTruncation() * scale;
+    retry.max_correspondence_distance = config.EffectiveMaxCorrespondence() * scale;
+    retry.voxel = config.retry_voxel;
+  }
+  return retry;
+}
+
+}  // namespace
+
+RegistrationResult RegisterPair(const Points& source, const Points& target,
+                                const BoIcpConfig& requested, const std::optional<Transform>& prior,
+                                const RegistrationCallbacks& callbacks) {
+  const auto started = std::chrono::steady_clock::now();
+  BoIcpConfig config = requested;
+  std::vector<std::string> auto_fields;
+  if (!config.automatic.empty()) {
+    auto_fields = ApplyChosenSettings(
+        ChooseSettingsForClouds({&source, &target}, CloudFormat::kAuto, config.seed), config);
+  }
+  ValidateConfig(config);
+
+  RegistrationResult result;
+  const auto attempt = [&](const BoIcpConfig& attempt_config) {
+    const auto attempt_started = std::chrono::steady_clock::now();
+    SearchOutcome outcome = SearchAndRefine(source, target, attempt_config, prior, callbacks);
+    result.attempts.push_back(
+        {attempt_config.mode, attempt_config.seed, outcome.refined.score.fitness,
+         outcome.confidence, static_cast<int>(outcome.history.size()),
+         std::chrono::duration<double>(std::chrono::steady_clock::now() - attempt_started).count(),
+         false});
+    return outcome;
+  };
+  SearchOutcome kept = attempt(config);
+  size_t kept_index = 0;
+  if (config.retry_when_doubtful && kept.confidence < kDoubtfulBelow) {
+    SearchOutcome second = attempt(RetryConfig(config));
+    if (second.refined.score.fitness > kept.refined.score.fitness) {
+      kept = std::move(second);
+      kept_index = 1;
+    }
+  }
+  result.attempts[kept_index].kept = true;
+
+  result.transform = kept.refined.transform;
+  result.objective = kept.objective;
+  result.fitness = kept.refined.score.fitness;
+  result.inlier_rmse = kept.refined.score.inlier_rmse;
+  result.overlap = kept.overlap;
+  result.probability_better = kept.probability_better;
+  result.features = kept.features;
+  result.confidence = kept.confidence;
   result.doubtful = result.confidence < kDoubtfulBelow;
-  result.gp_mean = last.gp_mean_at_best;
-  result.gp_std = last.gp_std_at_best;
-  result.evaluations = static_cast<int>(search.history().size());
-  result.abandoned =
-      static_cast<int>(std::count_if(search.history().begin(), search.history().end(),
-                                     [](const Evaluation& e) { return e.abandoned; }));
-  result.source_points = search_source.size();
-  result.target_points = prepared.search_target.size();
-  result.history = std::move(search.history());
+  result.gp_mean = kept.gp_mean;
+  result.gp_std = kept.gp_std;
+  result.evaluations = static_cast<int>(kept.history.size());
+  result.source_points = kept.source_points;
+  result.target_points = kept.target_points;
+  result.history = std::move(kept.history);
+  result.config = config;
+  result.auto_fields = std::move(auto_fields);
   result.runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;

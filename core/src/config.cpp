@@ -18,6 +18,23 @@ std::string SearchModeName(SearchMode mode) {
   return mode == SearchMode::kNested ? "nested" : "6dof";
 }
 
+const std::vector<std::string> kAutoRegistrationFields = {
+    "voxel", "refine_voxel", "objective_truncation", "translation_bounds", "rotation_bounds"};
+
+Eigen::Vector3d SnapRotationBounds(const Eigen::Vector3d& bounds) {
+  constexpr double kSnap = 1e-3;
+  Eigen::Vector3d snapped = bounds;
+  for (int axis : {0, 2}) {
+    if (std::abs(snapped[axis] - M_PI) < kSnap) snapped[axis] = M_PI;
+  }
+  if (std::abs(snapped[1] - M_PI / 2) < kSnap) snapped[1] = M_PI / 2;
+  return snapped;
+}
+
+void BoIcpConfig::MarkSet(const std::string& field) {
+  automatic.erase(std::remove(automatic.begin(), automatic.end(), field), automatic.end());
+}
+
 BayesOptOptions RegistrationBayesOptOptions() {
   BayesOptOptions options;
   options.acquisition.random_candidates = 1000;
@@ -80,15 +97,17 @@ void ValidateConfig(const BoIcpConfig& c) {
   Require(c.random_samples >= 1, "random samples (N_r) must be at least 1");
   Require(c.iterations >= 0, "iterations (N) must not be negative");
   Require(std::isfinite(c.voxel) && c.voxel > 0.0, "voxel must be a positive number of metres");
+  Require(std::isfinite(c.retry_voxel) && c.retry_voxel >= 0.0,
+          "retry voxel must be >= 0 metres (0 = the search voxel)");
   Require(FiniteNonNegative(c.rotation_bounds),
           "rotation bounds must be finite and non-negative (radians)");
   Require(FiniteNonNegative(c.translation_bounds),
           "translation bounds must be finite and non-negative (metres)");
   Require(c.rotation_bounds.maxCoeff() > 0.0 || c.translation_bounds.maxCoeff() > 0.0,
           "rotation and translation bounds are all zero: nothing to search");
-  Require(c.rotation_bounds[0] <= M_PI + 1e-9 && c.rotation_bounds[2] <= M_PI + 1e-9,
-          "roll and yaw bounds must not exceed pi");
-  Require(c.rotation_bounds[1] <= M_PI / 2 + 1e-9,
+  const Eigen::Vector3d rotation = SnapRotationBounds(c.rotation_bounds);
+  Require(rotation[0] <= M_PI && rotation[2] <= M_PI, "roll and yaw bounds must not exceed pi");
+  Require(rotation[1] <= M_PI / 2,
           "pitch bound must not exceed pi/2 (larger pitches repeat rotations already covered)");
   Require(std::isfinite(c.max_correspondence_distance) && c.max_correspondence_distance >= 0.0,
           "max correspondence distance must be >= 0 (0 = 3 x voxel)");
@@ -106,6 +125,11 @@ void ValidateConfig(const BoIcpConfig& c) {
               c.max_range >= 0.0 && (c.max_range == 0.0 || c.max_range > c.min_range),
           "ranges must satisfy 0 <= min_range < max_range (max_range 0 = no limit)");
   Require(c.threads >= 1, "threads must be at least 1");
+  for (const std::string& field : c.automatic) {
+    Require(std::find(kAutoRegistrationFields.begin(), kAutoRegistrationFields.end(), field) !=
+                kAutoRegistrationFields.end(),
+            "'" + field + "' is not a setting that can be chosen automatically");
+  }
 }
 
 }  // namespace boicp

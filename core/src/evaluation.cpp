@@ -68,7 +68,8 @@ PerturbationKind ParsePerturbationKind(const std::string& name) {
   if (name == "none") return PerturbationKind::kNone;
   if (name == "yaw") return PerturbationKind::kYaw;
   if (name == "axis90") return PerturbationKind::kAxis90;
-  throw InputError("unknown perturbation '" + name + "' (expected none, yaw or axis90)");
+  if (name == "any") return PerturbationKind::kAnyRotation;
+  throw InputError("unknown perturbation '" + name + "' (expected none, yaw, axis90 or any)");
 }
 
 std::string PerturbationKindName(PerturbationKind kind) {
@@ -79,6 +80,8 @@ std::string PerturbationKindName(PerturbationKind kind) {
       return "yaw";
     case PerturbationKind::kAxis90:
       return "axis90";
+    case PerturbationKind::kAnyRotation:
+      return "any";
   }
   return "none";
 }
@@ -95,6 +98,11 @@ Transform RandomPerturbation(PerturbationKind kind, std::mt19937_64& rng) {
     axis.normalize();
     std::uniform_real_distribution<double> angle(0.0, M_PI / 2);
     P.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle(rng), axis).toRotationMatrix();
+  } else if (kind == PerturbationKind::kAnyRotation) {
+    // A normalised 4-D Gaussian is a uniform unit quaternion.
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    Eigen::Quaterniond q(gauss(rng), gauss(rng), gauss(rng), gauss(rng));
+    P.topLeftCorner<3, 3>() = q.normalized().toRotationMatrix();
   }
   return P;
 }

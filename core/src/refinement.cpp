@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <string>
 
@@ -104,9 +105,15 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
     options.truncation = 1.5 * voxel;
     std::vector<Candidate> survivors;
     for (size_t k = 0; k < alive.size(); ++k) {
-      options.abandon_above = k == 0 ? std::numeric_limits<double>::infinity() : survivors[0].score;
+      options.abandon_above =
+          k == 0 ? std::numeric_limits<double>::infinity() : kClearlyWorse * survivors[0].score;
       const IcpResult icp = AlignPointToPoint(source, target, alive[k].T, options);
       if (icp.abandoned) continue;
+      const bool met = std::any_of(survivors.begin(), survivors.end(), [&](const Candidate& c) {
+        const Transform delta = c.T.inverse() * icp.transform;
+        return TranslationNorm(delta) < voxel && RotationAngle(delta) < M_PI / 180.0;
+      });
+      if (met) continue;
       survivors.push_back({icp.transform, ScoreAlignment(source, target, icp.transform,
                                                          options.truncation, options.threads)
                                               .truncated_mean});
@@ -121,9 +128,21 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
     run_level(level.source, level.target, level.voxel, 3.0 * level.voxel);
   }
   const PyramidLevel& finest = pair.pyramid.back();
-  const Transform& best = alive.front().T;
-  return {best, ScoreAlignment(finest.source, finest.target, best, config.EffectiveInlierDistance(),
-                               config.threads)};
+  std::vector<AlignmentScore> scores;
+  for (const Candidate& c : alive) {
+    scores.push_back(ScoreAlignment(finest.source, finest.target, c.T,
+                                    config.EffectiveInlierDistance(), config.threads));
+  }
+  // Largest inlier fraction first; ties keep the truncated-mean order.
+  std::vector<size_t> order(alive.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return scores[a].fitness > scores[b].fitness; });
+  RefinedAlignment refined{alive[order[0]].T, scores[order[0]], 1.0};
+  if (order.size() > 1 && refined.score.fitness > 0.0) {
+    refined.margin = 1.0 - scores[order[1]].fitness / refined.score.fitness;
+  }
+  return refined;
 }
 
 }  // namespace boicp

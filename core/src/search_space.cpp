@@ -1,5 +1,7 @@
 #include "boicp/search_space.hpp"
 
+#include "boicp/config.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -28,7 +30,7 @@ Transform SearchSpace::ToTransform(const Eigen::VectorXd& u) const {
 std::vector<bool> SearchSpace::Periodic() const {
   std::vector<bool> periodic;
   for (SearchParameter p : parameters) {
-    periodic.push_back((p == kRoll || p == kYaw) && half_widths[p] >= M_PI - 1e-9);
+    periodic.push_back((p == kRoll || p == kYaw) && half_widths[p] >= M_PI);
   }
   return periodic;
 }
@@ -39,7 +41,7 @@ SearchSpace MakeSearchSpace(const Transform& anchor, const Point& pivot,
   SearchSpace space;
   space.anchor = anchor;
   space.pivot = pivot;
-  space.half_widths << rotation_half_widths, translation_half_widths;
+  space.half_widths << SnapRotationBounds(rotation_half_widths), translation_half_widths;
   for (int p = kRoll; p <= kZ; ++p) {
     if (space.half_widths[p] > 0.0) space.parameters.push_back(static_cast<SearchParameter>(p));
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <random>
 
 #include "boicp/bo_icp.hpp"
 #include "boicp/evaluation.hpp"
@@ -30,6 +31,8 @@ StreetPair MakeStreetPair(double yaw) {
 
 BoIcpConfig SmallConfig(SearchMode mode) {
   BoIcpConfig config = PresetConfig("A");
+  config.automatic.clear();  // the preset's fixed voxel and translation box
+  config.retry_when_doubtful = false;
   config.mode = mode;
   config.rotation_bounds = Eigen::Vector3d(0.2, 0.2, M_PI);  // a car: any yaw, small roll and pitch
   config.evaluation_points = 1000;
@@ -117,33 +120,33 @@ TEST(BoIcp, SameSeedSameAnswerAndThreadCountDoesNotMatter) {
   }
 }
 
-TEST(BoIcp, OnlyTheTranslationStageAbandonsStartsAndNeverItsBest) {
-  const StreetPair pair = MakeStreetPair(2.3);
+// Two unrelated blobs of noise: no answer fits, so the first search is
+// doubtful and a second one runs in 6 DOF with another seed.
+TEST(BoIcp, DoubtfulAnswerIsSearchedAgainInSixDof) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-5.0, 5.0);
+  Points source, target;
+  for (int i = 0; i < 2000; ++i) {
+    source.emplace_back(u(rng), u(rng), u(rng));
+    target.emplace_back(u(rng), u(rng), u(rng));
+  }
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
-  config.abandon_hopeless = true;
-  const RegistrationResult result = RegisterPair(pair.source, pair.target, config);
-  int abandoned = 0;
-  double best_translation = std::numeric_limits<double>::infinity();
-  for (const Evaluation& e : result.history) {
-    if (e.stage == 0) {
-      EXPECT_FALSE(e.abandoned) << "the rotation stage never abandons";
-    }
-    if (e.stage == 1 && !e.abandoned) best_translation = std::min(best_translation, e.objective);
-    abandoned += e.abandoned ? 1 : 0;
-  }
-  EXPECT_EQ(result.abandoned, abandoned);
-  EXPECT_GT(abandoned, 0);
-  // An abandoned start could not beat the incumbent of its round, which is at
-  // least the stage's best.
-  for (const Evaluation& e : result.history) {
-    if (e.abandoned) {
-      EXPECT_GT(e.objective, best_translation);
-    }
-  }
+  config.iterations = 3;
+  config.retry_voxel = 2.0 * config.voxel;
+  config.retry_when_doubtful = true;
+  const RegistrationResult result = RegisterPair(source, target, config);
+  EXPECT_TRUE(result.doubtful);
+  ASSERT_EQ(result.attempts.size(), 2u);
+  EXPECT_EQ(result.attempts[0].mode, SearchMode::kNested);
+  EXPECT_EQ(result.attempts[1].mode, SearchMode::kSixDof);
+  EXPECT_NE(result.attempts[0].seed, result.attempts[1].seed);
+  EXPECT_NE(result.attempts[0].kept, result.attempts[1].kept);
+  const Attempt& kept = result.attempts[0].kept ? result.attempts[0] : result.attempts[1];
+  EXPECT_EQ(kept.fitness, result.fitness);
+  EXPECT_GE(kept.fitness, std::min(result.attempts[0].fitness, result.attempts[1].fitness));
 
-  BoIcpConfig keep_all = config;
-  keep_all.abandon_hopeless = false;
-  EXPECT_EQ(RegisterPair(pair.source, pair.target, keep_all).abandoned, 0);
+  config.retry_when_doubtful = false;
+  EXPECT_EQ(RegisterPair(source, target, config).attempts.size(), 1u);
 }
 
 TEST(BoIcp, PriorIsTheFirstSample) {
@@ -161,8 +164,7 @@ TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
   const StreetPair pair = MakeStreetPair(0.9);
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 3;
-  config.abandon_hopeless = false;     // the hook runs every ICP to the end...
-  config.coarse_icp_points = 0;        // ...in one part...
+  config.coarse_icp_points = 0;        // the hook runs every ICP in one part...
   config.join_converged_runs = false;  // ...and to its own end
   const RegistrationResult plain = RegisterPair(pair.source, pair.target, config);
 

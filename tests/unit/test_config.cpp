@@ -49,6 +49,26 @@ std::string ValidationMessage(const BoIcpConfig& c) {
   return "";
 }
 
+TEST(Config, BoundsWithinAThousandthOfPiArePi) {
+  const Eigen::Vector3d snapped = SnapRotationBounds(Eigen::Vector3d(3.14159, 1.5705, 3.1416));
+  EXPECT_EQ(snapped, Eigen::Vector3d(M_PI, M_PI / 2, M_PI));
+  EXPECT_EQ(SnapRotationBounds(Eigen::Vector3d(3.13, 1.56, 0.2)), Eigen::Vector3d(3.13, 1.56, 0.2));
+  BoIcpConfig c = PresetConfig("C");
+  c.rotation_bounds = Eigen::Vector3d(3.1416, 1.5709, 3.1416);  // a hair above pi: still pi
+  EXPECT_NO_THROW(ValidateConfig(c));
+}
+
+TEST(Config, PresetsLeaveScaleAndBoxesToTheData) {
+  BoIcpConfig c = PresetConfig("C");
+  EXPECT_EQ(c.automatic, kAutoRegistrationFields);
+  c.MarkSet("voxel");
+  c.MarkSet("rotation_bounds");
+  EXPECT_EQ(c.automatic, (std::vector<std::string>{"refine_voxel", "objective_truncation",
+                                                   "translation_bounds"}));
+  c.automatic.push_back("seed");
+  EXPECT_THAT(ValidationMessage(c), HasSubstr("'seed'"));
+}
+
 TEST(Config, RejectsInvalidFieldsByName) {
   BoIcpConfig c = PresetConfig("A");
   c.voxel = 0.0;

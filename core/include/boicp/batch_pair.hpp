@@ -7,6 +7,7 @@
 #include <functional>
 #include <vector>
 
+#include "boicp/auto_settings.hpp"
 #include "boicp/bo_icp.hpp"
 #include "boicp/map_assembly.hpp"
 #include "boicp/map_pairs.hpp"
@@ -28,6 +29,22 @@ struct BatchPairResult {
 BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
                                   const BoIcpConfig& job_config,
                                   const std::function<bool()>& stop_requested = {});
+
+/// Which map settings a batch leaves to be chosen from its scans.
+struct MapAutoFields {
+  bool resolution = true;  // OccupancySettings::resolution, reported as "map_resolution"
+  bool max_range = true;   // OccupancySettings::max_range, reported as "map_max_range"
+};
+
+/// Chooses, once for the whole batch, the fields of `config` still in
+/// config.automatic and the map fields `map_auto` names, from up to 5 of the
+/// scans spread evenly over the batch (so every pair, every shard and every
+/// resume gets the same settings). Returns the names of the fields it set;
+/// loads nothing when nothing is automatic. Throws InputError when a scan
+/// does not load or is too small to choose settings from.
+std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans,
+                                            BoIcpConfig& config, OccupancySettings& occupancy,
+                                            const MapAutoFields& map_auto);
 
 /// The keyframe overlap threshold of a batch: that of its first non-depth
 /// scan's format (0.7), or 0.6 when every scan is a depth image.

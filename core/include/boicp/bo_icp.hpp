@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "boicp/confidence.hpp"
 #include "boicp/config.hpp"
 #include "boicp/types.hpp"
 
@@ -21,7 +22,17 @@ struct Evaluation {
   Transform initial = Transform::Identity();  // T0 that BO proposed
   Transform result = Transform::Identity();   // where ICP took it
   double objective = 0.0;                     // truncated mean distance after ICP, metres
-  bool abandoned = false;  // ICP stopped early: it could not beat the incumbent of its round
+};
+
+/// One search of a registration: the first, and the retry of a doubtful one.
+struct Attempt {
+  SearchMode mode = SearchMode::kNested;
+  uint64_t seed = 0;
+  double fitness = 0.0;  // inlier fraction of its refined answer at the finest level
+  double confidence = 0.0;
+  int evaluations = 0;
+  double runtime_s = 0.0;
+  bool kept = false;  // its answer is the result's
 };
 
 /// A result whose confidence is below this is reported as doubtful.
@@ -40,16 +51,21 @@ struct RegistrationResult {
   /// Estimated probability, in [0,1], that `transform` is within the success
   /// thresholds (2 degrees, and a few refinement voxels).
   double confidence = 0.0;
-  bool doubtful = false;  // confidence < kDoubtfulBelow
+  bool doubtful = false;            // confidence < kDoubtfulBelow
+  ConfidenceFeatures features;      // what confidence was computed from
   double gp_mean = 0.0;             // GP posterior mean at the optimum (last stage), metres
   double gp_std = 0.0;              // GP posterior standard deviation there, metres
   double probability_better = 0.0;  // max over stages of the GP's P(some other point is better)
-  int evaluations = 0;              // ICP runs made by the search
-  int abandoned = 0;                // of which stopped early as unable to win
-  double runtime_s = 0.0;           // wall time of RegisterPair
+  int evaluations = 0;              // ICP runs made by the kept search
+  double runtime_s = 0.0;           // wall time of RegisterPair, retries included
   size_t source_points = 0;         // after search downsampling
   size_t target_points = 0;
-  std::vector<Evaluation> history;
+  std::vector<Evaluation> history;  // of the kept search
+  std::vector<Attempt> attempts;    // every search made, first first
+  /// The settings used, automatic fields resolved, and the names of those
+  /// chosen from the clouds.
+  BoIcpConfig config;
+  std::vector<std::string> auto_fields;
 };
 
 struct RegistrationProgress {
@@ -72,9 +88,12 @@ struct RegistrationCallbacks {
 };
 
 /// Registers `source` onto `target` (raw clouds in their sensor frames).
-/// `prior`, when given (for example odometry), centres the search box and is
-/// the first sample. Throws InputError for an invalid config or a cloud left
-/// empty by cropping/downsampling, and Cancelled when stop_requested fires.
+/// Fields still in config.automatic are first chosen from the two clouds
+/// (auto_settings.hpp). `prior`, when given (for example odometry), centres
+/// the search box and is the first sample. A doubtful answer is searched for
+/// once more when config.retry_when_doubtful. Throws InputError for an
+/// invalid config, a cloud too small to choose settings from or left empty by
+/// cropping/downsampling, and Cancelled when stop_requested fires.
 RegistrationResult RegisterPair(const Points& source, const Points& target,
                                 const BoIcpConfig& config,
                                 const std::optional<Transform>& prior = std::nullopt,

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -22,8 +23,25 @@ std::string SearchModeName(SearchMode mode);
 /// BoIcpConfig::bo).
 BayesOptOptions RegistrationBayesOptOptions();
 
+/// The registration fields automatic settings may choose (auto_settings.hpp),
+/// by the names reported in "auto".
+extern const std::vector<std::string> kAutoRegistrationFields;
+
+/// Snaps roll and yaw half-widths within 1e-3 of pi to pi, and a pitch
+/// half-width within 1e-3 of pi/2 to pi/2, so that a bound typed as 3.1416
+/// still wraps around.
+Eigen::Vector3d SnapRotationBounds(const Eigen::Vector3d& bounds);
+
 struct BoIcpConfig {
   std::string preset = "C";  // name of the preset these values started from
+  /// Fields still to be chosen from the clouds (names from
+  /// kAutoRegistrationFields); their values below are the preset's fixed ones
+  /// until then. RegisterPair chooses them from the pair; a batch chooses them
+  /// once (ChooseSettingsForClouds) and clears the list. Empty: every value
+  /// as set (--fixed-settings).
+  std::vector<std::string> automatic = kAutoRegistrationFields;
+  /// Removes `field` from `automatic`: the user set it.
+  void MarkSet(const std::string& field);
 
   // --- Search (the paper's N_r, N and voxel) -------------------------------
   int random_samples = 30;  // N_r: space-filling samples per search stage
@@ -47,40 +65,28 @@ struct BoIcpConfig {
   // looser overlap (a view slid along a wall) does not outscore the true one.
   double objective_truncation = 0.0;
   int icp_max_iterations = 60;  // per evaluation; fewer shrink the basin each start reaches
-  // Source points (random, seeded) each evaluation uses; 0 = all. 2000 is
-  // the fewest that kept every real-data test pair that 3000 did: 1500 lost
-  // the 40 %-overlap 7-Scenes pair 450->475, 1000 a bench pair.
+  // Source points (random, seeded) each evaluation uses; 0 = all. Fewer lose
+  // the true basin of low-overlap pairs (bench/README.md).
   size_t evaluation_points = 2000;
   // Each evaluation's ICP first runs on this many of those points (random,
   // seeded), where a step costs half, then finishes on all of them with the
   // iterations left of icp_max_iterations, but at least
   // finish_icp_iterations; its end is scored on all of them. 0 = the whole run
-  // on evaluation_points. Measured on the bench: 1000 kept 17/17 7-Scenes
-  // pairs at 1.55 s; 750 lost one and 500 two (500 was 25 % faster on KITTI).
+  // on evaluation_points.
   size_t coarse_icp_points = 1000;
-  // 5 finishing iterations instead of 10 cut the 7-Scenes ICP time by 14 %,
-  // with the same successes over the bench's 35 pairs at three seeds.
   int finish_icp_iterations = 5;
   // An evaluation whose ICP comes within half a voxel and 0.01 rad of where
   // an earlier one converged stops and takes over that end and its score
-  // (IcpOptions::join_translation): measured, a quarter less ICP work with
-  // the same ends. Off: every evaluation runs its ICP to its own end.
+  // (IcpOptions::join_translation): a run that far in cannot leave the basin.
+  // Off: every evaluation runs its ICP to its own end.
   bool join_converged_runs = true;
-  // Stop an evaluation's ICP in a translation-only stage once its projected
-  // end cannot beat the best objective found before its round
-  // (IcpOptions::abandon_above). Off: measured on the bench it saved about a
-  // fifth of the search time but lost the true basin of the hardest bunny
-  // pair, whose right start slides slowly before it snaps into place.
-  bool abandon_hopeless = false;
 
   // --- Final refinement of the best candidate ------------------------------
   double refine_voxel = 0.0;  // metres, finest level of the refinement pyramid; 0 = voxel / 4
   int refine_max_iterations = 60;
   int refine_candidates = 3;  // distinct best search results refined; the best fit at the end wins
   // Source points (random, seeded) ICP uses at each level finer than the
-  // search voxel; 0 = all. A 7-Scenes frame still has 30,000 or more at
-  // 1.25 cm; 10,000 halved the refinement time with the same accuracy on the
-  // bench pairs.
+  // search voxel; 0 = all. Beyond 10,000 the refined pose no longer improves.
   size_t refine_source_points = 10000;
   double inlier_distance =
       0.0;  // metres, for fitness / inlier_rmse / confidence; 0 = 1.5 x refine voxel
@@ -92,10 +98,20 @@ struct BoIcpConfig {
   // --- Surrogate and acquisition ----------------------------------------------
   // random_samples / iterations are copied into it per stage. 1000 uniform EI
   // candidates per proposal instead of the library's 2000: a nested stage
-  // searches 3 dimensions, and BOBYQA refines the best five anyway. Over the
-  // bench's 35 pairs at three seeds (with finish_icp_iterations 5) the
-  // surrogate's time fell by about a third with as many successes.
+  // searches 3 dimensions, and BOBYQA refines the best five anyway.
   BayesOptOptions bo = RegistrationBayesOptOptions();
+
+  // --- Checking the answer ---------------------------------------------------
+  // A doubtful first answer (confidence < kDoubtfulBelow) starts one more
+  // search: in 6 DOF (a nested search commits to one rotation before it
+  // looks at translations), with another seed, at retry_voxel. The extra
+  // budget is one search of the same N_r and N. The better fit at the same
+  // finest level is kept.
+  bool retry_when_doubtful = true;
+  // Search voxel of the retry, metres; 0 = voxel. Automatic settings make it
+  // coarser than the first search's: a smoother objective with wider basins,
+  // which finds the pairs (low overlap, large turns) a fine one misses.
+  double retry_voxel = 0.0;
 
   uint64_t seed = 1;  // drives the initial design, subsampling and acquisition
   // ICP runs of one BO round (config.bo.batch_size of them) that run at once.

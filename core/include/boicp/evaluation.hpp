@@ -32,12 +32,14 @@ double RotationErrorDeg(const Transform& estimate, const Transform& reference);
 double TranslationErrorM(const Transform& estimate, const Transform& reference);
 
 enum class PerturbationKind {
-  kNone,    // identity
-  kYaw,     // rotation about z by a uniform angle in [-pi, pi] (ground vehicles)
-  kAxis90,  // uniform random axis, uniform angle in [0, 90 degrees]
+  kNone,         // identity
+  kYaw,          // rotation about z by a uniform angle in [-pi, pi] (ground vehicles)
+  kAxis90,       // uniform random axis, uniform angle in [0, 90 degrees]
+  kAnyRotation,  // uniform over all rotations
 };
 
-PerturbationKind ParsePerturbationKind(const std::string& name);  // "none" | "yaw" | "axis90"
+/// "none" | "yaw" | "axis90" | "any"
+PerturbationKind ParsePerturbationKind(const std::string& name);
 std::string PerturbationKindName(PerturbationKind kind);
 
 /// A rotation about the sensor origin drawn as `kind` describes. Apply it to

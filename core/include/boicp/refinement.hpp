@@ -50,15 +50,24 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
 struct RefinedAlignment {
   Transform transform = Transform::Identity();
   AlignmentScore score;
+  /// 1 - (runner-up's fitness / the answer's fitness) at the finest level, in
+  /// [0, 1]: 0 when another basin fits as well, 1 when none reached that level.
+  double margin = 1.0;
 };
 
 /// Coarse-to-fine point-to-point ICP from each of `starts` (T_target_source,
 /// best guess first; at least one): the search clouds with a 1.5 voxel gate,
-/// then each pyramid level with a gate of 3 of its voxels. Returns the start
-/// that fits best at the finest level. At every level the leader (the best fit
-/// so far) runs first; the others are abandoned as soon as they cannot beat
-/// its truncated mean distance (clipped at 1.5 voxels of the level), so a
-/// start in a wrong basin costs a few coarse iterations instead of a full run.
+/// then each pyramid level with a gate of 3 of its voxels. At every level the
+/// leader (the best truncated mean so far, clipped at 1.5 voxels of the level)
+/// runs first, and the others are abandoned only once they head for a clearly
+/// worse fit (kClearlyWorse times the leader's), so a wrong basin costs a few
+/// coarse iterations while a near tie reaches the finest level. Runs that meet
+/// (within one voxel of the level and 1 degree) continue as one. Of the basins
+/// that reach the finest level, the one with the largest inlier fraction
+/// wins: the coarse scores of a low-overlap pair's true basin and of a wrong
+/// one can differ by less than their noise, while the fine fit tells them apart.
+constexpr double kClearlyWorse = 1.3;
+
 RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const PreparedPair& pair,
                                     const BoIcpConfig& config);
 

@@ -1,0 +1,21 @@
+#pragma once
+// How sure a registration is of its answer: a logistic model over what the
+// search and the refinement already measured, fitted on bench outcomes
+// (bench/fit_confidence.py; bench/README.md has its AUROC and reliability).
+
+namespace boicp {
+
+/// What the engine knows about its own answer when it finishes.
+struct ConfidenceFeatures {
+  double fitness = 0.0;     // inlier fraction at the finest level, in [0, 1]
+  double rmse_ratio = 0.0;  // inlier RMSE / inlier distance, in [0, 1]
+  double margin = 0.0;      // RefinedAlignment::margin, in [0, 1]
+  double support = 0.0;     // share of the first stage's runs that ended in the answer's basin
+  double probability_better = 0.0;  // the surrogate's P(an unexplored start does better)
+};
+
+/// Estimated probability, in (0, 1), that the answer is within the success
+/// thresholds (2 degrees, and a few refinement voxels of translation).
+double Confidence(const ConfidenceFeatures& features);
+
+}  // namespace boicp

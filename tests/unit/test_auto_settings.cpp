@@ -1,0 +1,138 @@
+// Settings chosen from the clouds: they follow the scene's scale, the
+// sensor's view and the user's overrides.
+
+#include <random>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "boicp/auto_settings.hpp"
+#include "boicp/bo_icp.hpp"
+#include "boicp/synthetic_scene.hpp"
+
+namespace boicp {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+// A LiDAR scan of the generated street, 1.8 m above level ground.
+Points StreetScan() {
+  const std::vector<SyntheticScan> drive = MakeSyntheticDrive(1, 3);
+  return drive.front().points;
+}
+
+// A depth camera's view: a wall 3 m ahead and a floor 1.5 m below, inside a
+// 60-degree cone about +z (the camera frame's forward axis).
+Points CameraView() {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Points points;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = 1.5 * u(rng), depth = 1.5 + 1.5 * (u(rng) + 1.0);
+    points.push_back(i % 2 == 0 ? Point(x, 1.5 * u(rng), 3.0) : Point(x, 1.5, depth));
+  }
+  return points;
+}
+
+Points Scaled(const Points& points, double factor) {
+  Points out;
+  for (const Point& p : points) out.push_back(factor * p);
+  return out;
+}
+
+TEST(AutoSettings, LevelLidarTurnsOnlyAboutZ) {
+  const Points scan = StreetScan();
+  const ChosenSettings chosen = ChooseSettingsForClouds({&scan, &scan}, CloudFormat::kAuto, 1);
+  EXPECT_EQ(chosen.sensor, SensorKind::kLidar);
+  EXPECT_DOUBLE_EQ(chosen.rotation_bounds.z(), M_PI);
+  EXPECT_LT(chosen.rotation_bounds.x(), 0.5);
+  EXPECT_LT(chosen.rotation_bounds.y(), 0.5);
+  // The ground holds the height: z gets far less room than x and y.
+  EXPECT_LT(chosen.translation_bounds.z(), 0.5 * chosen.translation_bounds.x());
+  EXPECT_GT(chosen.map_max_range, 0.0);
+}
+
+TEST(AutoSettings, ConeOfViewMayTurnAnyhow) {
+  const Points view = CameraView();
+  for (CloudFormat format : {CloudFormat::kAuto, CloudFormat::kDepthPng}) {
+    const ChosenSettings chosen = ChooseSettingsForClouds({&view}, format, 1);
+    EXPECT_NE(chosen.sensor, SensorKind::kLidar);
+    EXPECT_EQ(chosen.rotation_bounds, Eigen::Vector3d(M_PI, M_PI / 2, M_PI));
+  }
+  EXPECT_EQ(ChooseSettingsForClouds({&view}, CloudFormat::kDepthPng, 1).sensor,
+            SensorKind::kDepthCamera);
+}
+
+TEST(AutoSettings, LengthsFollowTheScenesScale) {
+  const Points view = CameraView();
+  const Points large = Scaled(view, 10.0);
+  const ChosenSettings small = ChooseSettingsForClouds({&view}, CloudFormat::kAuto, 1);
+  const ChosenSettings big = ChooseSettingsForClouds({&large}, CloudFormat::kAuto, 1);
+  EXPECT_NEAR(big.voxel, 10.0 * small.voxel, 1e-6 * big.voxel);
+  EXPECT_TRUE(big.translation_bounds.isApprox(10.0 * small.translation_bounds, 1e-6));
+  EXPECT_NEAR(big.map_resolution, 10.0 * small.map_resolution, 1e-6 * big.map_resolution);
+  EXPECT_EQ(big.rotation_bounds, small.rotation_bounds);
+}
+
+TEST(AutoSettings, TooSmallOrFlatCloudIsOneClearError) {
+  const Points few(50, Point(1, 2, 3));
+  try {
+    MeasureCloud(few, 1);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("too few"));
+    EXPECT_THAT(e.what(), HasSubstr("--voxel"));
+  }
+  const Points one_place(500, Point(1, 2, 3));
+  EXPECT_THROW(MeasureCloud(one_place, 1), InputError);
+}
+
+TEST(AutoSettings, OnlyFieldsLeftAutomaticAreChosen) {
+  const Points scan = StreetScan();
+  const ChosenSettings chosen = ChooseSettingsForClouds({&scan}, CloudFormat::kAuto, 1);
+  BoIcpConfig config = PresetConfig("C");
+  config.voxel = 0.5;
+  config.MarkSet("voxel");
+  const std::vector<std::string> set = ApplyChosenSettings(chosen, config);
+  EXPECT_THAT(set, ElementsAre("refine_voxel", "objective_truncation", "translation_bounds",
+                               "rotation_bounds"));
+  EXPECT_DOUBLE_EQ(config.voxel, 0.5);
+  EXPECT_EQ(config.retry_voxel, 0.0);  // a voxel the user set is kept for the retry too
+  EXPECT_DOUBLE_EQ(config.objective_truncation, 0.75);
+  EXPECT_LE(config.refine_voxel, 0.5 / 4);
+  EXPECT_TRUE(config.automatic.empty());
+
+  BoIcpConfig fixed = PresetConfig("C");
+  fixed.automatic.clear();
+  EXPECT_TRUE(ApplyChosenSettings(chosen, fixed).empty());
+  EXPECT_DOUBLE_EQ(fixed.voxel, 0.6);
+}
+
+TEST(AutoSettings, PresetsKeepTheirVoxelRatio) {
+  const Points scan = StreetScan();
+  const ChosenSettings chosen = ChooseSettingsForClouds({&scan}, CloudFormat::kAuto, 1);
+  BoIcpConfig a = PresetConfig("A"), c = PresetConfig("C");
+  ApplyChosenSettings(chosen, a);
+  ApplyChosenSettings(chosen, c);
+  EXPECT_NEAR(a.voxel / c.voxel, 0.7 / 0.6, 1e-12);
+  EXPECT_DOUBLE_EQ(c.voxel, chosen.voxel);
+  EXPECT_GT(c.retry_voxel, c.voxel);
+}
+
+TEST(AutoSettings, RegisterPairReportsWhatItChose) {
+  const std::vector<SyntheticScan> drive = MakeSyntheticDrive(2, 8);
+  BoIcpConfig config = PresetConfig("A");
+  config.iterations = 5;
+  config.retry_when_doubtful = false;
+  const RegistrationResult result =
+      RegisterPair(drive[0].points, drive[1].points, config, std::nullopt);
+  EXPECT_THAT(result.auto_fields, ElementsAre("voxel", "refine_voxel", "objective_truncation",
+                                              "translation_bounds", "rotation_bounds"));
+  EXPECT_TRUE(result.config.automatic.empty());
+  EXPECT_GT(result.config.voxel, 0.0);
+  EXPECT_EQ(result.attempts.size(), 1u);
+}
+
+}  // namespace
+}  // namespace boicp
