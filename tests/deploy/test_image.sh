@@ -108,16 +108,16 @@ log "built $image in ${build_s} s; size $((size / 1000000)) MB"
 
 # Anything that compiles, and any header, means build files leaked into the runtime stage.
 # shellcheck disable=SC2016  # expanded by the container's shell
-leaks=$("$engine" run --rm --network host --entrypoint sh "$image" -c '
+leaks=$("$engine" run --rm --no-healthcheck --network host --entrypoint sh "$image" -c '
   for c in cc c++ gcc g++ clang clang++ cpp ld as make cmake; do
     command -v "$c" >/dev/null 2>&1 && echo "compiler/tool: $c"
   done
   find /usr/include /usr/local/include -type f 2>/dev/null | head -n 5 | sed "s/^/header: /"
-  dpkg-query -W -f "\${Package}\n" | grep -E -- "-dev$|^(gcc|g\+\+|clang)" | sed "s/^/package: /"
+  dpkg-query -W -f "\${Package}\n" | grep -E -- "-dev$|^(gcc|g\+\+|cpp|clang|llvm)(-[0-9]+)?$" | sed "s/^/package: /"
   true')
 [ -z "$leaks" ] || fail "the runtime image holds build files:
 $leaks"
-uid=$("$engine" run --rm --network host "$image" id -u)
+uid=$("$engine" run --rm --no-healthcheck --network host "$image" id -u)
 [ "$uid" = 10001 ] || fail "the image runs as uid $uid, want 10001"
 health_cmd=$("$engine" image inspect --format '{{json .Config.Healthcheck}}' "$image")
 case "$health_cmd" in
@@ -232,7 +232,7 @@ batch_out="$tmp/batch-out"
 mkdir -p "$batch_out"
 chmod 0777 "$batch_out"
 start=$(date +%s)
-"$engine" run --rm --network host -v "$scans:/scans:ro" -v "$batch_out:/out" "$image" \
+"$engine" run --rm --no-healthcheck --network host -v "$scans:/scans:ro" -v "$batch_out:/out" "$image" \
   boicp map /scans -o /out --count 4 "${map_flags[@]}" >"$tmp/batch.log" 2>&1 \
   || { tail -n 20 "$tmp/batch.log" >&2; fail "boicp map in the image"; }
 for f in map.bt map.ot trajectory.kitti trajectory.tum pairs.json preview.png; do
