@@ -50,6 +50,8 @@ cleanup() {
   set +e
   if [ -n "$compose_up" ]; then
     "${compose[@]}" down -v >"$tmp/compose-down.log" 2>&1
+    # podman-compose 1.0 leaves the project's network behind.
+    "$engine" network rm -f "${tag}_default" >/dev/null 2>&1
   fi
   for c in "${containers[@]}"; do
     if [ "$code" -ne 0 ]; then
@@ -106,16 +108,18 @@ log "built $image in ${build_s} s; size $((size / 1000000)) MB"
 
 # ------------------------------------------------------ runtime image content
 
-# Anything that compiles, and any header, means build files leaked into the runtime stage.
+# Anything that compiles, and any header, means build files leaked into the runtime
+# stage; a library the binaries cannot load means the runtime stage misses a package.
 # shellcheck disable=SC2016  # expanded by the container's shell
 leaks=$("$engine" run --rm --no-healthcheck --network host --entrypoint sh "$image" -c '
   for c in cc c++ gcc g++ clang clang++ cpp ld as make cmake; do
     command -v "$c" >/dev/null 2>&1 && echo "compiler/tool: $c"
   done
   find /usr/include /usr/local/include -type f 2>/dev/null | head -n 5 | sed "s/^/header: /"
+  ldd /usr/local/bin/boicpd /usr/local/bin/boicp | grep "not found" | sed "s/^/missing library: /"
   dpkg-query -W -f "\${Package}\n" | grep -E -- "-dev$|^(gcc|g\+\+|cpp|clang|llvm)(-[0-9]+)?$" | sed "s/^/package: /"
   true')
-[ -z "$leaks" ] || fail "the runtime image holds build files:
+[ -z "$leaks" ] || fail "the runtime image is wrong:
 $leaks"
 uid=$("$engine" run --rm --no-healthcheck --network host "$image" id -u)
 [ "$uid" = 10001 ] || fail "the image runs as uid $uid, want 10001"
@@ -124,7 +128,7 @@ case "$health_cmd" in
   *'"boicp","health"'* | *'"boicp", "health"'*) ;;
   *) fail "the image's HEALTHCHECK is $health_cmd, want CMD boicp health" ;;
 esac
-log "runtime image: no compiler, no headers, user $uid, HEALTHCHECK $health_cmd"
+log "runtime image: no compiler, no headers, every library found, user $uid, HEALTHCHECK $health_cmd"
 
 # ------------------------------------------------------------------ drive
 
