@@ -2,11 +2,12 @@
 """Compares a trajectory (KITTI format: one row-major 3x4 T_map_scan a line) with
 reference poses, pair by pair, so a constant offset of the map frame does not matter.
 
-Usage: check_trajectory.py TRAJECTORY.kitti --pairs-csv PAIRS.csv [--scans N]
+Usage: check_trajectory.py TRAJECTORY.kitti --pairs-csv PAIRS.csv
        check_trajectory.py TRAJECTORY.kitti --truth TRUTH.kitti
   --pairs-csv  rows source,target,T_target_source (3x4) of consecutive scans
-               (../shared/data/kitti00/pairs.csv); the first N-1 rows are used
-  --truth      the true T_map_scan of every scan (boicp demo-data's truth.kitti)
+               (../shared/data/kitti00/pairs.csv); with N poses, the first N-1 rows
+  --truth      the true T_map_scan of every scan (boicp demo-data's truth.kitti);
+               the first N are used
 Exits 1 when a consecutive pair is off by more than --max-rotation-deg or
 --max-translation-m (defaults 2 degrees and 0.3 m: a correct registration).
 """
@@ -67,10 +68,10 @@ def main():
     # T_target_source of each consecutive pair (source i, target i+1).
     if args.truth:
         truth = read_kitti(args.truth)
-        if len(truth) != len(poses):
-            print(f"{args.trajectory}: {len(poses)} poses, the truth has {len(truth)}")
+        if len(truth) < len(poses):
+            print(f"{args.trajectory}: {len(poses)} poses, the truth has only {len(truth)}")
             return 1
-        references = [multiply(inverse(truth[i + 1]), truth[i]) for i in range(len(truth) - 1)]
+        references = [multiply(inverse(truth[i + 1]), truth[i]) for i in range(len(poses) - 1)]
     else:
         with open(args.pairs_csv, encoding="utf-8") as f:
             rows = list(csv.DictReader(f))

@@ -160,7 +160,9 @@ start_daemon() {
   # systemd timers, so the test runs it with `podman healthcheck run`.
   [ "$engine" = docker ] && flags+=(--health-interval 2s)
   containers+=("$name")
-  "$engine" run "${flags[@]}" "$image" >/dev/null
+  # podman reports here that it cannot add systemd timers for the healthcheck.
+  "$engine" run "${flags[@]}" "$image" >/dev/null 2>"$tmp/run-$name.log" \
+    || { cat "$tmp/run-$name.log" >&2; fail "$engine run $name"; }
 }
 
 # Waits until the image's HEALTHCHECK passes in container NAME.
@@ -212,7 +214,7 @@ submit_and_export "$tmp/daemon"
 job=$(cat "$tmp/daemon/job")
 log "job $job: map.bt and trajectory exported in $(elapsed "$start") s"
 
-"$engine" stop -t 60 "$tag-a" >/dev/null
+"$engine" stop -t 60 "$tag-a" >/dev/null 2>>"$tmp/stop.log"
 code=$("$engine" inspect --format '{{.State.ExitCode}}' "$tag-a")
 "$engine" logs "$tag-a" >"$tmp/daemon-a.log" 2>&1
 [ "$code" = 0 ] || fail "boicpd exited $code after stop"
@@ -227,7 +229,7 @@ wait_healthy "$tag-b"
 grep -qi 'succeeded' "$tmp/show.log" || { cat "$tmp/show.log" >&2; fail "job $job is not succeeded after a restart"; }
 "$bin/boicp" export "$job" -o "$tmp/restart-map.bt" >/dev/null
 cmp -s "$tmp/daemon/map.bt" "$tmp/restart-map.bt" || fail "map.bt differs after a restart"
-"$engine" stop -t 60 "$tag-b" >/dev/null
+"$engine" stop -t 60 "$tag-b" >/dev/null 2>>"$tmp/stop.log"
 log "restart on the same volume: job $job still succeeded, same map.bt"
 
 # ------------------------------------------------------- one-shot batch job
