@@ -3,8 +3,9 @@
 #   docker run -d --name boicpd -e BOICPD_WORKERS=2 -p 127.0.0.1:50051:50051 \
 #     -v boicpd-data:/var/lib/boicpd boicp:0.1.0
 # The build stage uses the same dependency script and configure flags as
-# .ci/run but builds only the two binaries: the tests run on the host build
-# (.ci/run), which the image then runs through tests/deploy/test_image.sh.
+# .ci/run but builds only the two binaries: .ci/run runs the tests on its host
+# build, then runs this image with tests/deploy/test_image.sh. (podman keeps the
+# HEALTHCHECK only with `podman build --format docker`.)
 # The runtime stage holds only the runtime libraries and the two binaries.
 # tests/deploy/check_deploy.py (ctest deploy_*) keeps this file in step with
 # deploy/install-deps.sh, .ci/run and CMake.
