@@ -2,7 +2,7 @@
 """Keeps the deployment files in step with the build, without Docker or a cluster.
 
 Usage: check_deploy.py CHECK --root SRC --build-dir BUILD --boicpd PATH --boicp PATH
-CHECK is one of: dockerfile, runtime-packages, manifests, readme-table.
+CHECK is one of: dockerfile, runtime-packages, manifests, batch-commands, readme-table.
 Prints one line per problem and exits 1 when there is any; 77 (ctest's skip
 code here) when a tool the check needs is missing.
 """
@@ -124,7 +124,7 @@ def check_dockerfile(args):
     runs = [(stage, a) for stage, k, a in instructions if k == "RUN"]
     problems += check_apt_and_deps_script(runs, build_packages, runtime_packages)
     problems += check_build_flags(root, runs)
-    problems += check_test_labels(runs)
+    problems += check_build_targets(args, runs)
     problems += check_copied_binaries(args, instructions)
     problems += check_runtime_stage(instructions, known_env, root)
     return problems
@@ -167,19 +167,26 @@ def check_build_flags(root, runs):
     return []
 
 
-def check_test_labels(runs):
-    """The image build runs ctest on labels that need no shared data and no daemon."""
-    for _, argument in runs:
+def check_build_targets(args, runs):
+    """The image builds only the two binaries it ships and runs no tests: .ci/run ran them
+    on the host build, then runs the image itself (tests/deploy/test_image.sh)."""
+    problems, targets = [], None
+    wanted = sorted(os.path.basename(p) for p in (args.boicpd, args.boicp))
+    for stage, argument in runs:
         for words in shell_commands(argument):
             if words[:1] == ["ctest"]:
-                if "-L" not in words:
-                    return ["Dockerfile: ctest must select labels with -L (no realdata/server)"]
-                regex = words[words.index("-L") + 1]
-                wrong = [l for l in ("realdata", "server") if re.search(regex, l)]
-                if wrong or not re.search(regex, "unit"):
-                    return [f"Dockerfile: ctest -L {regex!r} must match unit, not {wrong}"]
-                return []
-    return ["Dockerfile: the build stage runs no ctest"]
+                problems.append("Dockerfile: no ctest in the image (.ci/run tests the host build)")
+            if words[:2] == ["cmake", "--build"] and stage == 0:
+                if "--target" not in words:
+                    problems.append(f"Dockerfile: cmake --build must build only --target {wanted}")
+                    continue
+                start = words.index("--target") + 1
+                targets = sorted(w for w in words[start:] if not w.startswith("-"))
+    if targets is not None and targets != wanted:
+        problems.append(f"Dockerfile: cmake --build --target {targets}, want {wanted}")
+    if targets is None and not problems:
+        problems.append("Dockerfile: the build stage has no cmake --build --target line")
+    return problems
 
 
 def check_copied_binaries(args, instructions):
@@ -411,6 +418,79 @@ def check_compose(root, image, known_env):
     return problems
 
 
+def command_words(text, subcommand):
+    """The words of the first `exec boicp SUBCOMMAND ...` of a shell script, lines joined."""
+    joined = text.replace("\\\n", " ")
+    for line in joined.splitlines():
+        words = shlex.split(line, comments=True) if not line.lstrip().startswith("#") else []
+        if words[:3] == ["exec", "boicp", subcommand]:
+            return words[1:]
+    return None
+
+
+def shard_command(words):
+    """(scans, out, K, N, {literal flag: value}) of a `boicp map ... --shard K/N` command;
+    flags whose value is a variable are the operator's and left out."""
+    if not words or words[:2] != ["boicp", "map"] or "--shard" not in words or "-o" not in words:
+        return None
+    k, _, n = words[words.index("--shard") + 1].rpartition("/")
+    fixed, rest = {}, list(words[3:])
+    i = 0
+    while i < len(rest):
+        flag = rest[i]
+        value = rest[i + 1] if i + 1 < len(rest) else ""
+        if flag in ("-o", "--shard"):
+            i += 2
+            continue
+        if flag.startswith("--") and "$" not in flag and "$" not in value:
+            fixed[flag] = value
+        i += 2 if flag.startswith("-") else 1
+    return words[2], words[words.index("-o") + 1], k, n, fixed
+
+
+def check_batch_commands(args):
+    """The Slurm shard task and the Kubernetes Indexed Job run the same shard command:
+    `boicp map SCANS -o OUT --shard K/N` with K 1-based from the scheduler's index, N the
+    number of tasks, the same fixed flags; and both merges are `boicp merge OUT -o OUT`."""
+    root = args.root
+    slurm_dir = os.path.join(root, "deploy", "slurm")
+    batch = os.path.join(root, "deploy", "k8s", "batch")
+    problems = []
+    job = load_yaml_documents([os.path.join(batch, "map-shards-job.yaml")])[0][1]
+    container = pod_spec(job)["containers"][0]
+    k8s_script = ""
+    if container.get("command") == ["sh", "-c"]:
+        k8s_script = " ".join(container.get("args", []))
+    k8s = shard_command(command_words(k8s_script, "map"))
+    slurm = shard_command(command_words(read(os.path.join(slurm_dir, "map-shards.sbatch")), "map"))
+    if k8s is None:
+        return ["deploy/k8s/batch/map-shards-job.yaml: no `exec boicp map ... -o ... --shard K/N`"]
+    if slurm is None:
+        return ["deploy/slurm/map-shards.sbatch: no `exec boicp map ... -o ... --shard K/N`"]
+    if (k8s[2], k8s[3]) != ("$((JOB_COMPLETION_INDEX + 1))", "${BOICP_SHARDS}"):
+        problems.append(f"map-shards-job.yaml: --shard {k8s[2]}/{k8s[3]}, want "
+                        "$((JOB_COMPLETION_INDEX + 1))/${BOICP_SHARDS}")
+    if (slurm[2], slurm[3]) != ("$((SLURM_ARRAY_TASK_ID))", "$SLURM_ARRAY_TASK_COUNT"):
+        problems.append(f"map-shards.sbatch: --shard {slurm[2]}/{slurm[3]}, want "
+                        "$((SLURM_ARRAY_TASK_ID))/$SLURM_ARRAY_TASK_COUNT")
+    # SLURM_ARRAY_TASK_ID is K itself only when the array is numbered 1..N.
+    if '--array="1-$shards"' not in read(os.path.join(slurm_dir, "submit.sh")):
+        problems.append('deploy/slurm/submit.sh: the array must be --array="1-$shards"')
+    if k8s[4] != slurm[4]:
+        problems.append(f"shard flags differ: Kubernetes {k8s[4]}, Slurm {slurm[4]}")
+    merge_job = load_yaml_documents([os.path.join(batch, "merge-job.yaml")])[0][1]
+    k8s_merge = pod_spec(merge_job)["containers"][0].get("command", [])
+    slurm_merge = command_words(read(os.path.join(slurm_dir, "merge.sbatch")), "merge")
+    for name, words in (("merge-job.yaml", k8s_merge), ("merge.sbatch", slurm_merge)):
+        if not words or len(words) != 5 or words[3] != "-o" or words[2] != words[4]:
+            problems.append(f"{name}: the merge must be `boicp merge OUT -o OUT`, got {words}")
+    if k8s_merge and k8s_merge[2] != k8s[1]:
+        problems.append("merge-job.yaml: merges another folder than the shards' -o")
+    if slurm_merge and not (slurm_merge[2] == "$1" and slurm[1] == "$out"):
+        problems.append("merge.sbatch: must merge its OUTDIR argument, the shards' -o")
+    return problems
+
+
 def check_readme_table(args):
     """README's Deploy table lists exactly boicpd's flags, their variables and defaults."""
     text = read(os.path.join(args.root, "README.md"))
@@ -442,6 +522,7 @@ CHECKS = {
     "dockerfile": check_dockerfile,
     "runtime-packages": check_runtime_packages,
     "manifests": check_manifests,
+    "batch-commands": check_batch_commands,
     "readme-table": check_readme_table,
 }
 
