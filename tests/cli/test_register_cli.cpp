@@ -43,7 +43,7 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
   const RunResult r = Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
                           (dir_ / "target.xyz").string() +
-                          " --config A --seed 3 --rotation-bounds 0.2,0.2,3.14159 --json");
+                          " --config A --seed 3 --rotation-bounds 0.2,0.2,pi --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);  // throws if anything else is on stdout
   for (const char* key : {"transform", "objective", "fitness", "inlier_rmse", "confidence",
@@ -60,6 +60,28 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   }
   EXPECT_EQ(j["config"]["preset"], "A");
   EXPECT_EQ(j["evaluations"], 60);  // nested: (10 + 20) per stage
+  // The rotation box was given ("pi" is pi); the rest came from the clouds.
+  EXPECT_EQ(j["config"]["rotation_bounds"][2].get<double>(), M_PI);
+  EXPECT_EQ(j["auto"], nlohmann::json({"voxel", "refine_voxel", "objective_truncation",
+                                       "translation_bounds"}));
+  EXPECT_FALSE(j["doubtful"].get<bool>());
+  ASSERT_EQ(j["attempts"].size(), 1u);
+  EXPECT_EQ(j["attempts"][0]["mode"], "nested");
+  EXPECT_TRUE(j["attempts"][0]["kept"].get<bool>());
+}
+
+TEST_F(Cli, FixedSettingsAndNoRetry) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const RunResult r = Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
+                          (dir_ / "target.xyz").string() +
+                          " --config A --seed 3 --iterations 5 --fixed-settings --no-retry --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["auto"].empty());
+  EXPECT_DOUBLE_EQ(j["config"]["voxel"].get<double>(), 0.7);
+  EXPECT_EQ(j["config"]["translation_bounds"], nlohmann::json({4.0, 2.0, 1.0}));
+  EXPECT_FALSE(j["config"]["retry_when_doubtful"].get<bool>());
+  EXPECT_EQ(j["attempts"].size(), 1u);
 }
 
 TEST_F(Cli, BadInputGivesOneLineErrorAndExitCode2) {
@@ -76,6 +98,7 @@ TEST_F(Cli, BadInputGivesOneLineErrorAndExitCode2) {
        "cloud.foo"},
       {pair + " --voxel -1", "voxel"},
       {pair + " --translation-bounds 1,2", "--translation-bounds"},
+      {pair + " --rotation-bounds 0.2,0.2,tau", "--rotation-bounds"},
       {pair + " --config Z", "preset"},
       {pair + " --max-range 0.01", "points after cropping"},
       {pair + " --prior /nonexistent_prior.txt", "nonexistent_prior"},
@@ -100,7 +123,8 @@ TEST_F(Cli, MissingRequiredFlagAndHelp) {
   EXPECT_EQ(help.exit_code, 0);
   for (const char* flag : {"--voxel", "--translation-bounds", "--rotation-bounds", "--format",
                            "--intrinsics", "--intrinsics-file", "--depth-scale", "--prior",
-                           "--config", "--mode", "--seed", "--json"}) {
+                           "--config", "--mode", "--seed", "--json", "--fixed-settings",
+                           "--no-retry"}) {
     EXPECT_THAT(help.out, HasSubstr(flag));
   }
 }

@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Fits the confidence model of core/src/confidence.cpp on bench outcomes.
+
+usage: fit_confidence.py --fit CSV [CSV...] --test CSV [CSV...]
+
+Every CSV is a boicp-bench results.csv. Rows of the BO methods (those with
+the feature columns) are the samples, `success` the label. The model is a
+logistic regression of success on fitness, rmse_ratio, margin, support and
+probability_better, fitted by Newton's method with a small ridge penalty on
+the --fit rows. It prints the weights as C++ constants, then for the --test
+rows (never used in the fit): the AUROC, the share of failures flagged
+doubtful (confidence < 0.5), the share of successes flagged, and a
+reliability table.
+"""
+
+import argparse
+import csv
+import sys
+
+import numpy as np
+
+FEATURES = ["fitness", "rmse_ratio", "margin", "support", "probability_better"]
+CONSTANTS = ["kFitness", "kRmseRatio", "kMargin", "kSupport", "kProbabilityBetter"]
+RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
+
+
+def read_samples(paths):
+    features, labels = [], []
+    for path in paths:
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                if row["experiment"] != "suite" or row.get("fitness", "") == "":
+                    continue
+                features.append([float(row[name]) for name in FEATURES])
+                labels.append(1.0 if row["success"] == "1" else 0.0)
+    return np.array(features), np.array(labels)
+
+
+def fit_logistic(x, y):
+    design = np.hstack([np.ones((len(x), 1)), x])
+    w = np.zeros(design.shape[1])
+    for _ in range(100):
+        p = 1.0 / (1.0 + np.exp(-design @ w))
+        gradient = design.T @ (p - y) + RIDGE * np.r_[0.0, w[1:]]
+        hessian = design.T @ (design * (p * (1 - p))[:, None]) + RIDGE * np.diag(
+            np.r_[0.0, np.ones(len(w) - 1)])
+        step = np.linalg.solve(hessian, gradient)
+        w -= step
+        if np.abs(step).max() < 1e-10:
+            break
+    return w
+
+
+def predict(w, x):
+    return 1.0 / (1.0 + np.exp(-(w[0] + x @ w[1:])))
+
+
+def auroc(scores, labels):
+    positives, negatives = scores[labels == 1], scores[labels == 0]
+    if len(positives) == 0 or len(negatives) == 0:
+        return float("nan")
+    wins = (positives[:, None] > negatives[None, :]).sum()
+    ties = (positives[:, None] == negatives[None, :]).sum()
+    return (wins + 0.5 * ties) / (len(positives) * len(negatives))
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--fit", nargs="+", required=True)
+    parser.add_argument("--test", nargs="+", required=True)
+    args = parser.parse_args(argv)
+    x_fit, y_fit = read_samples(args.fit)
+    x_test, y_test = read_samples(args.test)
+    if len(y_fit) == 0 or len(y_test) == 0:
+        sys.exit("fit_confidence.py: no BO rows with features in the --fit or --test files")
+    w = fit_logistic(x_fit, y_fit)
+    print(f"fitted on {len(y_fit)} runs ({int((1 - y_fit).sum())} failures)")
+    print(f"constexpr double kIntercept = {w[0]:.4g};")
+    for name, weight in zip(CONSTANTS, w[1:]):
+        print(f"constexpr double {name} = {weight:.4g};")
+
+    p = predict(w, x_test)
+    failures, successes = y_test == 0, y_test == 1
+    print(f"\ntested on {len(y_test)} other runs ({int(failures.sum())} failures)")
+    print(f"AUROC {auroc(p, y_test):.3f}")
+    if failures.any():
+        print(f"failures flagged doubtful: {int((p[failures] < 0.5).sum())}/{int(failures.sum())}")
+    print(f"successes flagged doubtful: {int((p[successes] < 0.5).sum())}/{int(successes.sum())}")
+    print("\n| confidence | runs | mean confidence | success rate |\n|---|---:|---:|---:|")
+    edges = [0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0001]
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        inside = (p >= lo) & (p < hi)
+        if inside.any():
+            print(f"| {lo:.1f}-{min(hi, 1.0):.1f} | {int(inside.sum())} | {p[inside].mean():.3f} | "
+                  f"{y_test[inside].mean():.3f} |")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
