@@ -359,7 +359,11 @@ MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairReco
   };
   const FusionSummary fusion =
       FuseScans(run.folder.scans, estimate.poses, run.map, paths, callbacks);
-  WriteMapPreview(paths.octomap_bt, estimate.poses, (dir / "preview.png").string());
+  UpDetectionOptions up_options;
+  if (!run.folder.scans.empty()) up_options.sensor_up = SensorUp(run.folder.scans[0].load.format);
+  const UpDirection up = WriteMapPreview(paths.octomap_bt, estimate.poses,
+                                         (dir / "preview.png").string(), {}, up_options);
+  std::fprintf(stderr, "preview: %s\n", up.reason.c_str());
 
   std::set<PairIndex> in_graph;
   for (size_t i = 0; i < chain.size(); ++i) {
