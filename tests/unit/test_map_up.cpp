@@ -8,6 +8,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "boicp/map_assembly.hpp"
 #include "boicp/map_preview.hpp"
@@ -126,10 +127,10 @@ TEST(DetectUp, FallsBackWithAReason) {
   // With a camera prior and no horizontal surface, up is the cameras' up.
   UpDetectionOptions camera;
   camera.sensor_up = Eigen::Vector3d(0, -1, 0);
-  const Transform level = PoseFromYawTranslation(0.0, {0, 0, 1});
-  const UpDirection from_cameras =
-      DetectUp({{0, 0, 0}}, {0.1}, 0.1,
-               {Transform(level * Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()))}, camera);
+  Transform level = Transform::Identity();  // camera y (down) along the map's -z
+  level.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const UpDirection from_cameras = DetectUp({{0, 0, 0}}, {0.1}, 0.1, {level}, camera);
   EXPECT_FALSE(from_cameras.detected);
   EXPECT_LT(AngleDeg(from_cameras.up, Eigen::Vector3d::UnitZ()), 1e-6);
 }
