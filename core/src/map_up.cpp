@@ -27,7 +27,8 @@ std::pair<Eigen::Vector3d, std::string> PriorUp(const std::vector<Transform>& po
                                                 const UpDetectionOptions& options) {
   if (options.sensor_up && !poses.empty()) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const Transform& T : poses) sum += T.topLeftCorner<3, 3>() * options.sensor_up->normalized();
+    for (const Transform& T : poses)
+      sum += T.topLeftCorner<3, 3>() * options.sensor_up->normalized();
     if (sum.norm() > 1e-6 * static_cast<double>(poses.size())) {
       return {sum.normalized(), "the sensors' up"};
     }

@@ -56,12 +56,11 @@ double LineProcessScale(const std::vector<PairConstraint>& constraints,
 // under `poses`: r^2 = e^T I e, with e Open3D's linearised misalignment
 // (rotation first) of T_target_source against the poses and I the edge's
 // full information. 1 = the poses agree with it exactly.
-double AgreementWithPoses(const PairConstraint& c, const std::vector<Transform>& poses,
-                          double mu) {
-  const Eigen::Matrix4d misfit = (c.T_target_source.inverse() *
-                                  poses[static_cast<size_t>(c.pair.target)].inverse() *
-                                  poses[static_cast<size_t>(c.pair.source)])
-                                     .matrix();
+double AgreementWithPoses(const PairConstraint& c, const std::vector<Transform>& poses, double mu) {
+  const Eigen::Matrix4d misfit =
+      (c.T_target_source.inverse() * poses[static_cast<size_t>(c.pair.target)].inverse() *
+       poses[static_cast<size_t>(c.pair.source)])
+          .matrix();
   Eigen::Matrix<double, 6, 1> e;
   e << (misfit(2, 1) - misfit(1, 2)) / 2.0, (misfit(0, 2) - misfit(2, 0)) / 2.0,
       (misfit(1, 0) - misfit(0, 1)) / 2.0, misfit(0, 3), misfit(1, 3), misfit(2, 3);
@@ -211,9 +210,15 @@ OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
   const double mu = LineProcessScale(constraints, options);
   std::vector<bool> active(constraints.size(), true);
   for (size_t e = 0; e < constraints.size(); ++e) {
+    const PairIndex& p = constraints[e].pair;
+    const int n = static_cast<int>(initial.size());
+    if (p.source < 0 || p.source >= n || p.target < 0 || p.target >= n) {
+      throw InputError("pose graph: constraint " + std::to_string(e) +
+                       " has an index out of range");
+    }
     if (IsLoopClosure(in_tree, e) && IsDoubtfulEdge(constraints[e])) {
-      active[e] = AgreementWithPoses(constraints[e], initial, mu) >=
-                  options.doubtful_keep_threshold;
+      active[e] =
+          AgreementWithPoses(constraints[e], initial, mu) >= options.doubtful_keep_threshold;
     }
   }
   return OptimizeActiveEdges(initial, constraints, in_tree, active, options);

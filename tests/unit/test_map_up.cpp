@@ -3,6 +3,7 @@
 // must keep z, and maps without horizontal surfaces fall back with a reason.
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -97,6 +98,8 @@ TEST(DetectUp, LidarStreetKeepsZ) {
     UpDetectionOptions options;
     if (lidar_prior) options.sensor_up = Eigen::Vector3d::UnitZ();
     const UpDirection up = DetectUp(cells.centres, cells.sizes, cells.resolution, poses, options);
+    std::printf("street (%s prior): %.2f degrees from z (%s)\n", lidar_prior ? "LiDAR" : "no",
+                AngleDeg(up.up, Eigen::Vector3d::UnitZ()), up.reason.c_str());
     EXPECT_TRUE(up.detected) << up.reason;
     EXPECT_LT(AngleDeg(up.up, Eigen::Vector3d::UnitZ()), 2.0) << up.reason;
   }

@@ -83,7 +83,7 @@ struct OptimizedPoses {
 /// closure the initial poses disagree with (doubtful_keep_threshold) is left
 /// out. With every confidence 1 this is Open3D's optimisation unchanged.
 /// Preconditions: `initial` has one pose per scan and in_tree one flag per
-/// constraint.
+/// constraint; a constraint naming a scan outside `initial` throws InputError.
 OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
                                  const std::vector<PairConstraint>& constraints,
                                  const std::vector<bool>& in_tree, const PoseGraphOptions& options);
