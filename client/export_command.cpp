@@ -8,6 +8,7 @@
 #include "boicp/atomic_file.hpp"
 #include "boicp/map_preview.hpp"
 #include "boicp/trajectory_io.hpp"
+#include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "remote_options.hpp"
 #include "remote_proto.hpp"
@@ -20,6 +21,7 @@ namespace fs = std::filesystem;
 struct ExportFlags {
   RemoteFlags remote;
   std::string job_id, format, output;
+  std::string sensor_up;  // "x,y,z" in the scan frame; empty = unknown
   bool preview = true;
 };
 
@@ -73,6 +75,8 @@ std::vector<Transform> TrajectoryOf(client::MapBuilderClient& client, const std:
 
 int RunExport(const ExportFlags& f) {
   const auto [kind, output] = ResolveFormat(f);
+  UpDetectionOptions up_options;
+  up_options.sensor_up = ParseSensorUp(f.sensor_up);
   Daemon daemon = ConnectToDaemon(f.remote);
   const v1::Job job = daemon.client->GetJob(f.job_id);
   if (job.state() != v1::JOB_STATE_SUCCEEDED) {
@@ -91,8 +95,9 @@ int RunExport(const ExportFlags& f) {
       kind.format == v1::EXPORT_FORMAT_OCTOMAP_BT || kind.format == v1::EXPORT_FORMAT_OCTOMAP_OT;
   if (octomap && f.preview) {
     const std::string png = fs::path(output).replace_extension(".png").string();
-    WriteMapPreview(output, TrajectoryOf(*daemon.client, f.job_id, png + ".poses.tmp"), png);
-    std::fprintf(stderr, "wrote %s (top-down preview)\n", png.c_str());
+    const UpDirection up = WriteMapPreview(
+        output, TrajectoryOf(*daemon.client, f.job_id, png + ".poses.tmp"), png, {}, up_options);
+    std::fprintf(stderr, "wrote %s (top-down preview; %s)\n", png.c_str(), up.reason.c_str());
   }
   return kOk;
 }
@@ -109,6 +114,7 @@ CommandRunner AddExportCommand(CLI::App& app) {
       "-o,--output", flags->output,
       "File to write (atomically: a staging file, then renamed); default: map.bt, map.ot, "
       "map.ply, trajectory.tum or trajectory.kitti");
+  app.add_option("--sensor-up", flags->sensor_up, kSensorUpHelp);
   app.add_flag("!--no-preview", flags->preview,
                "For bt/ot, skip the top-down preview PNG written next to FILE (FILE with .png)");
   AddRemoteOptions(app, flags->remote);

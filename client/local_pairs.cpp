@@ -58,6 +58,8 @@ PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex&
   record.fitness = r.fitness;
   record.inlier_rmse = r.inlier_rmse;
   record.confidence = r.confidence;
+  record.overlap = r.overlap;
+  record.doubtful = r.doubtful;
   record.evaluations = r.evaluations;
   record.runtime_s = r.runtime_s;
   record.seed = result.seed;
@@ -82,9 +84,20 @@ json PairRecordToJson(const PairRecord& r) {
           {"fitness", r.fitness},
           {"inlier_rmse", r.inlier_rmse},
           {"confidence", r.confidence},
+          {"doubtful", IsDoubtful(r)},
+          {"overlap", r.overlap ? json(*r.overlap) : json(nullptr)},
           {"evaluations", r.evaluations},
           {"runtime_s", r.runtime_s},
           {"seed", r.seed}};
+}
+
+bool IsDoubtful(const PairRecord& record) { return record.doubtful.value_or(false); }
+
+double PlannerOverlap(const PairRecord& record) { return record.overlap.value_or(record.fitness); }
+
+PairConstraint RecordConstraint(const PairRecord& record) {
+  return {record.pair, record.transform, record.information,
+          record.doubtful ? record.confidence : 1.0};
 }
 
 void WritePairFile(const std::string& out_dir, const PairRecord& record) {
@@ -119,6 +132,11 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
     r.fitness = j.at("fitness").get<double>();
     r.inlier_rmse = j.at("inlier_rmse").get<double>();
     r.confidence = j.at("confidence").get<double>();
+    // Files from before these keys existed stay readable: unknown, not doubtful.
+    if (j.contains("doubtful")) r.doubtful = j.at("doubtful").get<bool>();
+    if (j.contains("overlap") && !j.at("overlap").is_null()) {
+      r.overlap = j.at("overlap").get<double>();
+    }
     r.evaluations = j.at("evaluations").get<int>();
     r.runtime_s = j.at("runtime_s").get<double>();
     r.seed = j.at("seed").get<uint64_t>();

@@ -19,6 +19,12 @@ struct PairRecord {
   std::string source_path, target_path;
   Transform transform = Transform::Identity();  // T_target_source
   double objective = 0.0, fitness = 0.0, inlier_rmse = 0.0, confidence = 0.0;
+  /// Fraction of the source the target sees (RegistrationResult::overlap);
+  /// nullopt in files written before it was computed.
+  std::optional<double> overlap;
+  /// confidence < kDoubtfulBelow; nullopt in files written before confidence
+  /// was calibrated, which count as trusted.
+  std::optional<bool> doubtful;
   int evaluations = 0;
   double runtime_s = 0.0;
   uint64_t seed = 0;  // the pair's own seed
@@ -46,7 +52,19 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
 
 /// The JSON of pairs.json entries: source, target, source_path,
 /// target_path, transform (4x4 row-major), objective, fitness, inlier_rmse,
-/// confidence, evaluations, runtime_s, seed.
+/// confidence, doubtful, overlap (null when unknown), evaluations,
+/// runtime_s, seed.
 nlohmann::json PairRecordToJson(const PairRecord& record);
+
+/// Whether the record is marked doubtful (unmarked old files: no).
+bool IsDoubtful(const PairRecord& record);
+
+/// The overlap estimate the keyframe planner uses: the overlap, or the
+/// fitness for files written before overlap was computed.
+double PlannerOverlap(const PairRecord& record);
+
+/// The record as a pose-graph edge, weighted by its confidence (unmarked old
+/// files: fully trusted).
+PairConstraint RecordConstraint(const PairRecord& record);
 
 }  // namespace boicp::cli

@@ -1,5 +1,6 @@
 #include "local_pipeline.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -262,9 +263,10 @@ void PairProgress::Done(const PairRecord& record, bool reused) {
     std::fprintf(stderr, "\r[%s%s] %d/%d pairs  ETA %-8s", std::string(filled, '#').c_str(),
                  std::string(kWidth - filled, '.').c_str(), done_, total_, eta.c_str());
   } else {
-    std::fprintf(stderr, "pair %s %s (%d/%d): fitness %.3f, %.1f s, ETA %s\n",
+    std::fprintf(stderr, "pair %s %s (%d/%d): fitness %.3f, confidence %.2f%s, %.1f s, ETA %s\n",
                  PairName(record.pair).c_str(), reused ? "reused" : "done", done_, total_,
-                 record.fitness, record.runtime_s, eta.c_str());
+                 record.fitness, record.confidence, IsDoubtful(record) ? " (doubtful)" : "",
+                 record.runtime_s, eta.c_str());
   }
   std::fflush(stderr);
 }
@@ -392,7 +394,7 @@ std::string ManifestDifferences(const MapSettings& a, const MapSettings& b) {
 MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairRecord>& chain,
                                  const std::vector<PairRecord>& all, const std::string& out_dir) {
   std::vector<PairConstraint> constraints;
-  for (const PairRecord& r : chain) constraints.push_back({r.pair, r.transform, r.information});
+  for (const PairRecord& r : chain) constraints.push_back(RecordConstraint(r));
   const PoseEstimate estimate =
       EstimatePoses(run.folder.scans, constraints, BatchPoseGraphOptions(run.config));
 
@@ -416,7 +418,11 @@ MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairReco
   };
   const FusionSummary fusion =
       FuseScans(run.folder.scans, estimate.poses, run.map, paths, callbacks);
-  WriteMapPreview(paths.octomap_bt, estimate.poses, (dir / "preview.png").string());
+  UpDetectionOptions up_options;
+  if (!run.folder.scans.empty()) up_options.sensor_up = SensorUp(run.folder.scans[0].load.format);
+  const UpDirection up = WriteMapPreview(paths.octomap_bt, estimate.poses,
+                                         (dir / "preview.png").string(), {}, up_options);
+  std::fprintf(stderr, "preview: %s\n", up.reason.c_str());
 
   std::set<PairIndex> in_graph;
   for (size_t i = 0; i < chain.size(); ++i) {
@@ -429,12 +435,16 @@ MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairReco
     listing.push_back(std::move(entry));
   }
   WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
+  const int doubtful = static_cast<int>(
+      std::count_if(all.begin(), all.end(), [](const PairRecord& r) { return IsDoubtful(r); }));
 
   MapOutputSummary summary;
   summary.poses = estimate.poses;
   summary.optimised = estimate.optimised;
   summary.occupied_leaves = fusion.occupied_leaves;
   summary.fusion_s = fusion.seconds;
+  summary.pairs_doubtful = doubtful;
+  summary.pairs_listed = static_cast<int>(all.size());
   return summary;
 }
 

@@ -125,6 +125,8 @@ struct MapOutputSummary {
   bool optimised = false;
   size_t occupied_leaves = 0;
   double fusion_s = 0.0;
+  int pairs_listed = 0;    // `all`
+  int pairs_doubtful = 0;  // of which doubtful
 };
 
 /// From the chain's records (constraint order) to OUTDIR/map.bt, map.ot,

@@ -31,7 +31,7 @@ std::string Absolute(const std::string& path) {
 }
 
 // Overlap pairing: each scan onto the current keyframe, decided by the
-// registrations' fitness, in rounds of `threads` probes.
+// registrations' overlap estimates, in rounds of `threads` probes.
 std::map<PairIndex, PairRecord> RunKeyframes(const LocalRun& run, const std::string& out_dir,
                                              int threads, PairProgress& progress, int* reused,
                                              std::vector<PairIndex>* chain) {
@@ -42,7 +42,7 @@ std::map<PairIndex, PairRecord> RunKeyframes(const LocalRun& run, const std::str
     const std::vector<PairIndex> probes = planner.NextProbes(threads);
     if (probes.empty()) throw std::runtime_error("the keyframe plan stalled");
     for (auto& [pair, record] : RunPairs(run, probes, out_dir, threads, progress, reused)) {
-      planner.Record(pair, record.fitness);
+      planner.Record(pair, PlannerOverlap(record));
       all[pair] = std::move(record);
     }
     progress.SetTotal(static_cast<int>(all.size()) + n - planner.AttachedScans());
@@ -142,6 +142,8 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
                "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
                "preview.png}: %zu occupied leaves\n",
                out.c_str(), summary.occupied_leaves);
+  std::fprintf(stderr, "%s\n",
+               DoubtfulSummary(summary.pairs_doubtful, summary.pairs_listed).c_str());
   if (flags.json) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -154,6 +156,7 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
                       {"scans", run.folder.scans.size()},
                       {"pairs", records.size()},
                       {"pairs_reused", reused},
+                      {"pairs_doubtful", summary.pairs_doubtful},
                       {"pose_graph_optimised", summary.optimised},
                       {"occupied_leaves", summary.occupied_leaves},
                       {"runtime_s", seconds},

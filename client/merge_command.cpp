@@ -57,9 +57,12 @@ int RunMerge(const MergeFlags& flags) {
                  "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
                  "preview.png}: %zu occupied leaves\n",
                  flags.out_dir.c_str(), summary.occupied_leaves);
+    std::fprintf(stderr, "%s\n",
+                 DoubtfulSummary(summary.pairs_doubtful, summary.pairs_listed).c_str());
     if (flags.json) {
       std::cout << json{{"scans", run.folder.scans.size()},
                         {"pairs", records.size()},
+                        {"pairs_doubtful", summary.pairs_doubtful},
                         {"pose_graph_optimised", summary.optimised},
                         {"occupied_leaves", summary.occupied_leaves},
                         {"out", flags.out_dir}}

@@ -5,6 +5,7 @@
 
 #include "boicp/map_preview.hpp"
 #include "boicp/trajectory_io.hpp"
+#include "cli_parsing.hpp"
 #include "commands.hpp"
 
 namespace boicp::cli {
@@ -12,6 +13,7 @@ namespace {
 
 struct PreviewFlags {
   std::string map, out, trajectory;
+  std::string sensor_up;  // "x,y,z" in the scan frame; empty = unknown
   int size = 1024;
 };
 
@@ -37,8 +39,11 @@ int RunPreview(const PreviewFlags& f) {
         f.trajectory.empty() ? std::vector<Transform>{} : ReadTrajectory(f.trajectory);
     PreviewOptions options;
     options.size_px = f.size;
-    WriteMapPreview(f.map, poses, f.out, options);
-    std::cerr << "wrote " << f.out << "\n";
+    UpDetectionOptions up_options;
+    up_options.sensor_up = ParseSensorUp(f.sensor_up);
+    if (up_options.sensor_up && poses.empty()) throw InputError("--sensor-up: needs --trajectory");
+    const UpDirection up = WriteMapPreview(f.map, poses, f.out, options, up_options);
+    std::cerr << "wrote " << f.out << " (" << up.reason << ")\n";
     return kOk;
   } catch (const InputError& e) {
     std::cerr << "boicp preview: error: " << e.what() << std::endl;
@@ -56,6 +61,7 @@ CommandRunner AddPreviewCommand(CLI::App& app) {
   app.add_option("MAP", flags->map, "OctoMap file (.bt or .ot)")->required();
   app.add_option("-o,--out", flags->out, "PNG to write")->required();
   app.add_option("--trajectory", flags->trajectory, "Trajectory to draw (.tum or .kitti)");
+  app.add_option("--sensor-up", flags->sensor_up, kSensorUpHelp);
   app.add_option("--size", flags->size, "Longer side of the image (pixels, >= 64)")
       ->capture_default_str();
   return [flags] { return RunPreview(*flags); };

@@ -51,6 +51,7 @@ nlohmann::json JobToJson(const v1::Job& job) {
       {"stage", job.stage()},
       {"pairs_done", job.pairs_done()},
       {"pairs_total", job.pairs_total()},
+      {"pairs_doubtful", job.pairs_doubtful()},
       {"num_scans", job.num_scans()},
       {"stage_done", job.stage_done()},
       {"stage_total", job.stage_total()},
@@ -65,20 +66,23 @@ nlohmann::json JobToJson(const v1::Job& job) {
 }
 
 nlohmann::json PairToJson(const v1::PairResult& pair) {
-  return {{"source", pair.source()},
-          {"target", pair.target()},
-          {"source_scan_id", pair.source_scan_id()},
-          {"target_scan_id", pair.target_scan_id()},
-          {"transform", TransformToJson(TransformFromProto(pair.transform(), "pair.transform"))},
-          {"objective", pair.objective()},
-          {"fitness", pair.fitness()},
-          {"inlier_rmse", pair.inlier_rmse()},
-          {"confidence", pair.confidence()},
-          {"evaluations", pair.evaluations()},
-          {"runtime_s", pair.runtime_s()},
-          {"finished_at", pair.finished_at()},
-          {"seed", pair.seed()},
-          {"in_graph", pair.in_graph()}};
+  return {
+      {"source", pair.source()},
+      {"target", pair.target()},
+      {"source_scan_id", pair.source_scan_id()},
+      {"target_scan_id", pair.target_scan_id()},
+      {"transform", TransformToJson(TransformFromProto(pair.transform(), "pair.transform"))},
+      {"objective", pair.objective()},
+      {"fitness", pair.fitness()},
+      {"inlier_rmse", pair.inlier_rmse()},
+      {"confidence", pair.confidence()},
+      {"doubtful", pair.doubtful()},
+      {"overlap", pair.has_overlap() ? nlohmann::json(pair.overlap()) : nlohmann::json(nullptr)},
+      {"evaluations", pair.evaluations()},
+      {"runtime_s", pair.runtime_s()},
+      {"finished_at", pair.finished_at()},
+      {"seed", pair.seed()},
+      {"in_graph", pair.in_graph()}};
 }
 
 nlohmann::json ResultsToJson(const v1::JobResults& results) {

@@ -11,7 +11,7 @@
 
 namespace boicp::cli {
 
-/// {"job_id", "label", "state", "stage", "pairs_done", "pairs_total",
+/// {"job_id", "label", "state", "stage", "pairs_done", "pairs_total", "pairs_doubtful",
 ///  "num_scans", "stage_done", "stage_total", "eta_seconds", "created_at",
 ///  "started_at", "finished_at", "error", "cancel_requested",
 ///  "pose_graph_optimised"}; times are Unix seconds (0 = not yet).
@@ -26,7 +26,8 @@ nlohmann::json JobToJson(const v1::Job& job);
 
 /// {"source", "target", "source_scan_id", "target_scan_id", "transform"
 ///  (T_target_source), "objective", "fitness", "inlier_rmse", "confidence",
-///  "evaluations", "runtime_s", "finished_at", "seed", "in_graph"}.
+///  "doubtful" (false when the daemon stored none), "overlap" (null when
+///  unknown), "evaluations", "runtime_s", "finished_at", "seed", "in_graph"}.
 nlohmann::json PairToJson(const v1::PairResult& pair);
 
 /// The job's fields plus "pairs" (in plan order) and "trajectory"

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "boicp/batch_pair.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 
@@ -24,6 +25,10 @@ void PrintOutcome(const v1::Job& job) {
       std::fprintf(stderr, "job %s succeeded: %u scans, %u pairs in %s%s\n", job.job_id().c_str(),
                    job.num_scans(), job.pairs_done(), FormatDuration(took).c_str(),
                    job.pose_graph_optimised() ? ", pose graph optimised" : "");
+      std::fprintf(stderr, "%s\n",
+                   DoubtfulSummary(static_cast<int>(job.pairs_doubtful()),
+                                   static_cast<int>(job.pairs_done()))
+                       .c_str());
       return;
     case v1::JOB_STATE_FAILED:
       throw JobEndedBadly("job " + job.job_id() + " failed: " + job.error());
@@ -79,8 +84,9 @@ std::string ProgressLine(const v1::Job& job, const std::optional<v1::PairResult>
     line += " | ETA " + FormatDuration(job.eta_seconds());
   }
   if (registering && last_pair) {
-    std::snprintf(text, sizeof text, " | last %u->%u confidence %.2f", last_pair->source(),
-                  last_pair->target(), last_pair->confidence());
+    std::snprintf(text, sizeof text, " | last %u->%u confidence %.2f%s", last_pair->source(),
+                  last_pair->target(), last_pair->confidence(),
+                  last_pair->doubtful() ? " (doubtful)" : "");
     line += text;
   }
   return line;

@@ -35,7 +35,8 @@ class ProgressPrinter {
 };
 
 /// One line: "[registering] 5/9 pairs | 3.2 pairs/min | ETA 1m15s | last
-/// 4->5 confidence 0.83" (rate and last pair while registering only).
+/// 4->5 confidence 0.83" (rate and last pair while registering only; a
+/// doubtful last pair is marked "(doubtful)").
 /// `pairs_per_min` < 0 = unknown.
 std::string ProgressLine(const v1::Job& job, const std::optional<v1::PairResult>& last_pair,
                          double pairs_per_min);
@@ -48,8 +49,8 @@ std::string FormatDuration(double seconds);
 
 /// Checks the job exists (a control call with a short deadline), follows
 /// WatchJob until its final state with progress on stderr, and prints the
-/// outcome there. Returns kOk when the job SUCCEEDED; throws JobEndedBadly
-/// when it FAILED or was CANCELLED, RpcError when the daemon fails.
+/// outcome there (on success also "N of M pairs doubtful"). Returns kOk when the job SUCCEEDED;
+/// throws JobEndedBadly when it FAILED or was CANCELLED, RpcError when the daemon fails.
 int FollowJob(Daemon& daemon, const std::string& job_id);
 
 }  // namespace boicp::cli

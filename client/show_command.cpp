@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "boicp/batch_pair.hpp"
 #include "commands.hpp"
 #include "remote_json.hpp"
 #include "remote_options.hpp"
@@ -24,8 +25,8 @@ void PrintSummary(const v1::JobResults& results) {
   std::printf("state       %s (stage %s)%s\n", JobStateName(job.state()).c_str(),
               job.stage().c_str(), job.cancel_requested() ? ", cancel requested" : "");
   std::printf("scans       %u\n", job.num_scans());
-  std::printf("pairs       %u of %u done%s\n", job.pairs_done(), job.pairs_total(),
-              job.pose_graph_optimised() ? ", pose graph optimised" : "");
+  std::printf("pairs       %u of %u done, %u doubtful%s\n", job.pairs_done(), job.pairs_total(),
+              job.pairs_doubtful(), job.pose_graph_optimised() ? ", pose graph optimised" : "");
   if (job.started_at() > 0.0) {
     const double end = job.finished_at() > 0.0 ? job.finished_at() : job.started_at();
     std::printf("run time    %s%s\n", FormatDuration(end - job.started_at()).c_str(),
@@ -36,15 +37,22 @@ void PrintSummary(const v1::JobResults& results) {
     std::printf("settings    %s\n", DescribeChosenSettings(job.settings()).c_str());
   if (results.pairs_size() == 0) return;
   // T_target_source summarised by its translation and rotation angle.
-  std::printf("\n%6s %6s %8s %10s %11s %8s %7s %9s %9s %5s\n", "source", "target", "fitness",
-              "confidence", "rmse_m", "objective", "evals", "transl_m", "rot_deg", "time");
+  std::printf("\n%6s %6s %8s %8s %10s %11s %8s %7s %9s %9s %5s\n", "source", "target", "fitness",
+              "overlap", "confidence", "rmse_m", "objective", "evals", "transl_m", "rot_deg",
+              "time");
+  int doubtful = 0;
   for (const v1::PairResult& p : results.pairs()) {
     const Transform T = TransformFromProto(p.transform(), "pair.transform");
-    std::printf("%6u %6u %8.3f %10.3f %11.4f %8.4f %7u %9.3f %9.2f %5s%s\n", p.source(), p.target(),
-                p.fitness(), p.confidence(), p.inlier_rmse(), p.objective(), p.evaluations(),
-                TranslationNorm(T), RotationAngle(T) * 180.0 / M_PI,
-                FormatDuration(p.runtime_s()).c_str(), p.in_graph() ? "" : "  (not in graph)");
+    char overlap[32] = "-";  // unknown in results stored before it was computed
+    if (p.has_overlap()) std::snprintf(overlap, sizeof overlap, "%.3f", p.overlap());
+    std::printf("%6u %6u %8.3f %8s %10.3f %11.4f %8.4f %7u %9.3f %9.2f %5s%s%s\n", p.source(),
+                p.target(), p.fitness(), overlap, p.confidence(), p.inlier_rmse(), p.objective(),
+                p.evaluations(), TranslationNorm(T), RotationAngle(T) * 180.0 / M_PI,
+                FormatDuration(p.runtime_s()).c_str(), p.doubtful() ? "  doubtful" : "",
+                p.in_graph() ? "" : "  (not in graph)");
+    if (p.doubtful()) ++doubtful;
   }
+  std::printf("\n%s\n", DoubtfulSummary(doubtful, results.pairs_size()).c_str());
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "job_runner.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <filesystem>
@@ -40,6 +41,18 @@ constexpr auto kProgressInterval = std::chrono::seconds(1);
 
 PairIndex IndexOf(const v1::PairResult& result) {
   return {static_cast<int>(result.source()), static_cast<int>(result.target())};
+}
+
+// The keyframe planner's overlap estimate; results stored before overlap
+// was computed fall back to their fitness.
+double PlannerOverlap(const v1::PairResult& result) {
+  return result.has_overlap() ? result.overlap() : result.fitness();
+}
+
+// The pose-graph weight of a stored pair; results stored before confidence
+// was calibrated (no doubtful mark) are trusted, as they were then.
+double EdgeConfidence(const v1::PairResult& result) {
+  return result.has_doubtful() ? result.confidence() : 1.0;
 }
 
 std::pair<int, int> Unordered(const PairIndex& p) {
@@ -91,7 +104,7 @@ class JobRun {
     if (spec_.pairing == PairingMode::kKeyframes) {
       planner_.emplace(num_scans_, spec_.overlap_threshold);
       for (const auto& [pair, stored] : results_) {
-        planner_->Record(pair, stored.result.fitness());
+        planner_->Record(pair, PlannerOverlap(stored.result));
         probed_sources_.insert(pair.source);
       }
     } else {
@@ -271,19 +284,22 @@ class JobRun {
     results_[completion.pair] = *completion.stored;
     ++done_this_run_;
     last_done_ = Clock::now();
-    if (planner_) planner_->Record(completion.pair, r.fitness());
+    if (planner_) planner_->Record(completion.pair, PlannerOverlap(r));
     UpdateCounts();
     Persist();
     spdlog::info(
-        "job {} pair {} done in {:.2f} s ({}/{}): fitness {:.3f}, confidence {:.3f}, "
+        "job {} pair {} done in {:.2f} s ({}/{}): fitness {:.3f}, confidence {:.3f}{}, "
         "objective {:.4f} m",
         job_.job_id(), name, r.runtime_s(), job_.pairs_done(), job_.pairs_total(), r.fitness(),
-        r.confidence(), r.objective());
+        r.confidence(), r.doubtful() ? " (doubtful)" : "", r.objective());
     Publish(&r);
   }
 
   void UpdateCounts() {
     job_.set_pairs_done(static_cast<uint32_t>(results_.size()));
+    job_.set_pairs_doubtful(static_cast<uint32_t>(
+        std::count_if(results_.begin(), results_.end(),
+                      [](const auto& entry) { return entry.second.result.doubtful(); })));
     if (planner_) {
       // Keyframe plans grow as they go: what ran or runs, plus one probe per
       // scan not probed yet.
@@ -327,8 +343,8 @@ class JobRun {
     std::vector<PairIndex> used;
     auto add = [&](const PairIndex& p) {
       const StoredPair& stored = results_.at(p);
-      constraints.push_back(
-          {p, TransformFromProto(stored.result.transform(), "stored pair"), stored.information});
+      constraints.push_back({p, TransformFromProto(stored.result.transform(), "stored pair"),
+                             stored.information, EdgeConfidence(stored.result)});
       used.push_back(p);
     };
     for (const PairIndex& p : chain) add(p);
@@ -430,8 +446,10 @@ class JobRun {
       spdlog::error("job {} failed after {:.1f} s: {}", job_.job_id(), took, error);
       return RunOutcome::kFailed;
     }
-    spdlog::info("job {} {} after {:.1f} s ({} of {} pairs)", job_.job_id(), JobStateName(state),
-                 took, job_.pairs_done(), job_.pairs_total());
+    spdlog::info("job {} {} after {:.1f} s ({} of {} pairs; {})", job_.job_id(),
+                 JobStateName(state), took, job_.pairs_done(), job_.pairs_total(),
+                 DoubtfulSummary(static_cast<int>(job_.pairs_doubtful()),
+                                 static_cast<int>(job_.pairs_done())));
     return state == v1::JOB_STATE_SUCCEEDED ? RunOutcome::kSucceeded : RunOutcome::kCancelled;
   }
 

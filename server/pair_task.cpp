@@ -22,6 +22,8 @@ PairOutcome RegisterJobPair(const JobSpec& spec, const PairIndex& pair,
   out.set_fitness(r.fitness);
   out.set_inlier_rmse(r.inlier_rmse);
   out.set_confidence(r.confidence);
+  out.set_doubtful(r.doubtful);
+  out.set_overlap(r.overlap);
   out.set_evaluations(static_cast<uint32_t>(r.evaluations));
   out.set_runtime_s(r.runtime_s);
   out.set_finished_at(NowSeconds());

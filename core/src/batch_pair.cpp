@@ -84,6 +84,10 @@ double BatchOverlapThreshold(const std::vector<ScanSource>& scans) {
   return DefaultOverlapThreshold(CloudFormat::kDepthPng);
 }
 
+std::string DoubtfulSummary(int doubtful, int total) {
+  return std::to_string(doubtful) + " of " + std::to_string(total) + " pairs doubtful";
+}
+
 PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config) {
   PoseGraphOptions options;
   options.max_correspondence_distance = job_config.EffectiveInlierDistance();

@@ -86,21 +86,21 @@ std::vector<PairIndex> KeyframePlanner::NextProbes(int max_count) {
   std::vector<PairIndex> probes;
   while (static_cast<int>(probes.size()) < max_count && next_probe_ < num_scans_) {
     const PairIndex probe{next_probe_++, keyframe_};
-    if (fitness_.count(probe) == 0) probes.push_back(probe);
+    if (overlap_.count(probe) == 0) probes.push_back(probe);
   }
   return probes;
 }
 
-void KeyframePlanner::Record(const PairIndex& pair, double fitness) {
-  fitness_[pair] = fitness;
+void KeyframePlanner::Record(const PairIndex& pair, double overlap) {
+  overlap_[pair] = overlap;
   Advance();
 }
 
 void KeyframePlanner::Advance() {
   while (next_ < num_scans_) {
     const PairIndex probe{next_, keyframe_};
-    const auto found = fitness_.find(probe);
-    if (found == fitness_.end()) return;
+    const auto found = overlap_.find(probe);
+    if (found == overlap_.end()) return;
     if (found->second >= threshold_ || next_ == keyframe_ + 1) {
       chain_.push_back(probe);
       ++next_;

@@ -109,6 +109,20 @@ class Canvas {
   RgbImage image_;
 };
 
+// Rows: the picture's right, its top and `up` (map frame). The right is the
+// map's x laid flat (its y when x is along up), so up = z is the identity.
+Eigen::Matrix3d ViewRotation(const Eigen::Vector3d& up_in) {
+  const Eigen::Vector3d up = up_in.normalized();
+  Eigen::Vector3d right = Eigen::Vector3d::UnitX() - up.x() * up;
+  if (right.norm() < 1e-3) right = Eigen::Vector3d::UnitY() - up.y() * up;
+  right.normalize();
+  Eigen::Matrix3d rotation;
+  rotation.row(0) = right.transpose();
+  rotation.row(1) = up.cross(right).transpose();
+  rotation.row(2) = up.transpose();
+  return rotation;
+}
+
 }  // namespace
 
 OccupiedCells ReadOccupiedCells(const std::string& path) {
@@ -133,13 +147,25 @@ RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,
   if (cells.centres.empty() && trajectory.empty()) {
     throw InputError("preview: the map has no occupied cells and there is no trajectory");
   }
-  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+  if (!(options.up.norm() > 0.0)) throw InputError("preview: the up direction is zero");
+  // Everything in view coordinates: x right, y towards the top, z = height.
+  const Eigen::Matrix3d view = ViewRotation(options.up);
+  // A cube's shadow on the picture's axes: half an edge times the L1 norm
+  // of each axis in the map frame.
+  const Eigen::Vector2d shadow(view.row(0).cwiseAbs().sum(), view.row(1).cwiseAbs().sum());
+  Points centres, path;
+  std::vector<Eigen::Vector2d> halves;
   for (size_t i = 0; i < cells.centres.size(); ++i) {
-    const Eigen::Vector2d half = Eigen::Vector2d::Constant(cells.sizes[i] / 2);
-    lo = lo.cwiseMin(cells.centres[i].head<2>() - half);
-    hi = hi.cwiseMax(cells.centres[i].head<2>() + half);
+    centres.push_back(view * cells.centres[i]);
+    halves.push_back(shadow * cells.sizes[i] / 2);
   }
-  for (const Point& p : trajectory) {
+  for (const Point& p : trajectory) path.push_back(view * p);
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+  for (size_t i = 0; i < centres.size(); ++i) {
+    lo = lo.cwiseMin(centres[i].head<2>() - halves[i]);
+    hi = hi.cwiseMax(centres[i].head<2>() + halves[i]);
+  }
+  for (const Point& p : path) {
     lo = lo.cwiseMin(p.head<2>());
     hi = hi.cwiseMax(p.head<2>());
   }
@@ -159,23 +185,23 @@ RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,
     return height - margin - 1 - static_cast<int>(std::floor((y - lo.y()) * scale));
   };
 
-  if (!cells.centres.empty()) {
+  if (!centres.empty()) {
     std::vector<double> heights;
-    for (const Point& c : cells.centres) heights.push_back(c.z());
+    for (const Point& c : centres) heights.push_back(c.z());
     const double z_lo = Percentile(heights, 0.02), z_hi = Percentile(heights, 0.98);
     const double z_span = std::max(z_hi - z_lo, 1e-6);
     // Lower cells first, so that the highest one at each spot is the one seen.
-    std::vector<size_t> order(cells.centres.size());
+    std::vector<size_t> order(centres.size());
     std::iota(order.begin(), order.end(), size_t{0});
     std::sort(order.begin(), order.end(),
-              [&](size_t a, size_t b) { return cells.centres[a].z() < cells.centres[b].z(); });
+              [&](size_t a, size_t b) { return centres[a].z() < centres[b].z(); });
     for (size_t i : order) {
-      const Point& c = cells.centres[i];
-      const double h = cells.sizes[i] / 2;
+      const Point& c = centres[i];
+      const double hx = halves[i].x(), hy = halves[i].y();
       const Rgb colour = Turbo((c.z() - z_lo) / z_span);
-      canvas.Fill(column(c.x() - h), row(c.y() + h),
-                  std::max(column(c.x() + h), column(c.x() - h) + 1),
-                  std::max(row(c.y() - h), row(c.y() + h) + 1), colour);
+      canvas.Fill(column(c.x() - hx), row(c.y() + hy),
+                  std::max(column(c.x() + hx), column(c.x() - hx) + 1),
+                  std::max(row(c.y() - hy), row(c.y() + hy) + 1), colour);
     }
   }
   // Colour bar: low heights at the bottom.
@@ -186,18 +212,18 @@ RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,
   }
 
   const int thickness = std::max(2, options.size_px / 400);
-  for (size_t i = 1; i < trajectory.size(); ++i) {
-    canvas.Line(column(trajectory[i - 1].x()), row(trajectory[i - 1].y()),
-                column(trajectory[i].x()), row(trajectory[i].y()), thickness, kTrajectory);
+  for (size_t i = 1; i < path.size(); ++i) {
+    canvas.Line(column(path[i - 1].x()), row(path[i - 1].y()), column(path[i].x()),
+                row(path[i].y()), thickness, kTrajectory);
   }
-  if (!trajectory.empty()) {
+  if (!path.empty()) {
     const int mark = std::max(4, options.size_px / 100);
     auto square = [&](const Point& p, const Rgb& c) {
       canvas.Fill(column(p.x()) - mark, row(p.y()) - mark, column(p.x()) + mark + 1,
                   row(p.y()) + mark + 1, c);
     };
-    square(trajectory.front(), kStart);
-    square(trajectory.back(), kEnd);
+    square(path.front(), kStart);
+    square(path.back(), kEnd);
   }
   return canvas.Take();
 }
@@ -213,11 +239,17 @@ void WritePng(const std::string& path, const RgbImage& image) {
   });
 }
 
-void WriteMapPreview(const std::string& octomap_path, const std::vector<Transform>& poses,
-                     const std::string& png_path, const PreviewOptions& options) {
+UpDirection WriteMapPreview(const std::string& octomap_path, const std::vector<Transform>& poses,
+                            const std::string& png_path, const PreviewOptions& options,
+                            const UpDetectionOptions& up_options) {
   Points trajectory;
   for (const Transform& T : poses) trajectory.push_back(T.block<3, 1>(0, 3));
-  WritePng(png_path, RenderTopDown(ReadOccupiedCells(octomap_path), trajectory, options));
+  const OccupiedCells cells = ReadOccupiedCells(octomap_path);
+  const UpDirection up = DetectUp(cells.centres, cells.sizes, cells.resolution, poses, up_options);
+  PreviewOptions along_up = options;
+  along_up.up = up.up;
+  WritePng(png_path, RenderTopDown(cells, trajectory, along_up));
+  return up;
 }
 
 }  // namespace boicp

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -107,6 +108,56 @@ class MapCli : public ::testing::Test {
   fs::path dir_;
   std::vector<Transform> truth_;  // T_world_scan of MakeDrive's scans
 };
+
+// Rewrites one pair file through `edit` (a JSON object in, one out).
+void EditPairFile(const fs::path& file, const std::function<void(json&)>& edit) {
+  json j = json::parse(Slurp(file));
+  edit(j);
+  std::ofstream(file, std::ios::trunc) << j.dump(1);
+}
+
+TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
+  const fs::path scans = MakeDrive(4);
+  const fs::path out = dir_ / "out";
+  const std::string args = "map " + scans.string() + " -o " + out.string() + Quick() + " --json";
+  const RunResult first = Run(args);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  json pairs = json::parse(Slurp(out / "pairs.json"));
+  ASSERT_EQ(pairs.size(), 3u);
+  int doubtful = 0;
+  for (const json& p : pairs) {
+    ASSERT_TRUE(p.contains("doubtful") && p["doubtful"].is_boolean()) << p.dump();
+    ASSERT_TRUE(p.contains("overlap") && p["overlap"].is_number()) << p.dump();
+    EXPECT_EQ(p["doubtful"].get<bool>(), p["confidence"].get<double>() < 0.5);
+    EXPECT_GT(p["overlap"].get<double>(), 0.0);
+    doubtful += p["doubtful"].get<bool>();
+  }
+  EXPECT_EQ(json::parse(first.out)["pairs_doubtful"], doubtful);
+  EXPECT_THAT(first.err, HasSubstr(std::to_string(doubtful) + " of 3 pairs doubtful"));
+
+  // Files written before the marks existed load as trusted, overlap unknown;
+  // a file marked doubtful is counted as such.
+  for (const char* name : {"000000-000001.json", "000001-000002.json"}) {
+    EditPairFile(out / "pairs" / name, [](json& j) {
+      j.erase("doubtful");
+      j.erase("overlap");
+    });
+  }
+  EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) {
+    j["doubtful"] = true;
+    j["confidence"] = 0.1;
+  });
+  const RunResult again = Run(args);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(json::parse(again.out)["pairs_reused"], 3);
+  EXPECT_EQ(json::parse(again.out)["pairs_doubtful"], 1);
+  EXPECT_THAT(again.err, HasSubstr("1 of 3 pairs doubtful"));
+  EXPECT_THAT(again.err, HasSubstr("(doubtful)"));
+  pairs = json::parse(Slurp(out / "pairs.json"));
+  EXPECT_EQ(pairs[0]["doubtful"], false);
+  EXPECT_TRUE(pairs[0]["overlap"].is_null());
+  EXPECT_EQ(pairs[2]["doubtful"], true);
+}
 
 TEST_F(MapCli, GeneratedDriveWritesEveryOutputAndRerunsReusePairs) {
   const fs::path scans = MakeDrive(4);

@@ -36,6 +36,7 @@ using boicp::test::RunCaptured;
 using boicp::test::RunResult;
 using boicp::test::Slurp;
 
+using ::testing::ContainsRegex;
 using ::testing::HasSubstr;
 using ::testing::MatchesRegex;
 using ::testing::Not;
@@ -113,6 +114,7 @@ class RemoteCli : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 0) << r.err << "\n" << daemon_->Log();
     EXPECT_THAT(r.out, MatchesRegex("job-[0-9]+\n")) << r.out;
     EXPECT_THAT(r.err, HasSubstr("succeeded"));
+    EXPECT_THAT(r.err, ContainsRegex("[0-9]+ of [0-9]+ pairs doubtful")) << r.err;
     return Lines(r.out).empty() ? "" : Lines(r.out)[0];
   }
 
@@ -178,6 +180,15 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_EQ(j["label"], "drive4");
   ASSERT_EQ(j["pairs"].size(), 3u);
   ASSERT_EQ(j["trajectory"].size(), 4u);
+  int doubtful = 0;
+  for (const auto& pair : j["pairs"]) {
+    ASSERT_TRUE(pair["doubtful"].is_boolean()) << pair.dump();
+    EXPECT_EQ(pair["doubtful"].get<bool>(), pair["confidence"].get<double>() < 0.5);
+    ASSERT_TRUE(pair["overlap"].is_number()) << pair.dump();
+    EXPECT_GT(pair["overlap"].get<double>(), 0.0);
+    doubtful += pair["doubtful"].get<bool>();
+  }
+  EXPECT_EQ(j["pairs_doubtful"], doubtful);
   for (const auto& pair : j["pairs"]) {
     // T_target_source of consecutive scans against the generated truth.
     const int s = pair["source"], t = pair["target"];
@@ -192,6 +203,7 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   const RunResult human = Run("show " + job + server_);
   ASSERT_EQ(human.exit_code, 0) << human.err;
   EXPECT_THAT(human.out, HasSubstr("succeeded"));
+  EXPECT_THAT(human.out, HasSubstr(std::to_string(doubtful) + " of 3 pairs doubtful"));
 
   // The address may come from BOICP_SERVER instead of --server.
   const RunResult jobs = Run("jobs --json", "BOICP_SERVER=" + daemon_->address());

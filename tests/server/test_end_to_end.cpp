@@ -152,10 +152,16 @@ TEST_F(EndToEnd, BatchToOctomapAndTrajectory) {
   const v1::JobResults results = client.Results(done.job_id());
   ASSERT_EQ(results.pairs_size(), n - 1);
   ASSERT_EQ(results.trajectory_size(), n);
+  uint32_t doubtful = 0;
   for (const v1::PairResult& pair : results.pairs()) {
     EXPECT_GT(pair.fitness(), 0.5);
     EXPECT_EQ(pair.transform().m_size(), 16);
+    ASSERT_TRUE(pair.has_doubtful() && pair.has_overlap());
+    EXPECT_EQ(pair.doubtful(), pair.confidence() < 0.5);
+    EXPECT_GT(pair.overlap(), 0.0);
+    doubtful += pair.doubtful();
   }
+  EXPECT_EQ(done.pairs_doubtful(), doubtful);
 
   const fs::path bt = dir_ / "map.bt", tum = dir_ / "trajectory.tum", kit = dir_ / "traj.kitti";
   EXPECT_GT(client.ExportToFile(done.job_id(), v1::EXPORT_FORMAT_OCTOMAP_BT, bt.string()), 0u);

@@ -52,9 +52,9 @@ TEST(MapPairs, DefaultOverlapThresholdsAreThePapers) {
   EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(CloudFormat::kDepthPng), 0.6);
 }
 
-// Feeds the planner fitness values from a table until it is done.
+// Feeds the planner overlap values from a table until it is done.
 std::vector<PairIndex> RunPlanner(int scans, double threshold,
-                                  const std::function<double(PairIndex)>& fitness, int window,
+                                  const std::function<double(PairIndex)>& overlap, int window,
                                   std::vector<PairIndex>* probed = nullptr) {
   KeyframePlanner planner(scans, threshold);
   for (int guard = 0; guard < 1000 && !planner.Done(); ++guard) {
@@ -62,7 +62,7 @@ std::vector<PairIndex> RunPlanner(int scans, double threshold,
     if (probes.empty()) ADD_FAILURE() << "planner stalled";
     for (const PairIndex& p : probes) {
       if (probed) probed->push_back(p);
-      planner.Record(p, fitness(p));
+      planner.Record(p, overlap(p));
     }
   }
   return planner.ChainPairs();
@@ -71,23 +71,23 @@ std::vector<PairIndex> RunPlanner(int scans, double threshold,
 TEST(KeyframePlanner, NewKeyframeWhenOverlapDropsBelowThreshold) {
   // Overlap falls by 0.15 per scan of distance: scans 1 and 2 see keyframe 0
   // well enough (0.85, 0.7), scan 3 does not (0.55), so 2 becomes the keyframe.
-  const auto fitness = [](PairIndex p) { return 1.0 - 0.15 * std::abs(p.source - p.target); };
-  EXPECT_THAT(RunPlanner(6, 0.7, fitness, 1),
+  const auto overlap = [](PairIndex p) { return 1.0 - 0.15 * std::abs(p.source - p.target); };
+  EXPECT_THAT(RunPlanner(6, 0.7, overlap, 1),
               ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}, PairIndex{4, 2},
                           PairIndex{5, 4}));
 }
 
 TEST(KeyframePlanner, SameChainWhateverTheWindow) {
-  const auto fitness = [](PairIndex p) { return 1.0 - 0.1 * std::abs(p.source - p.target); };
-  const auto one = RunPlanner(9, 0.75, fitness, 1);
-  EXPECT_EQ(RunPlanner(9, 0.75, fitness, 4), one);
-  EXPECT_EQ(RunPlanner(9, 0.75, fitness, 16), one);
+  const auto overlap = [](PairIndex p) { return 1.0 - 0.1 * std::abs(p.source - p.target); };
+  const auto one = RunPlanner(9, 0.75, overlap, 1);
+  EXPECT_EQ(RunPlanner(9, 0.75, overlap, 4), one);
+  EXPECT_EQ(RunPlanner(9, 0.75, overlap, 16), one);
   EXPECT_EQ(one.size(), 8u);
 }
 
 TEST(KeyframePlanner, AdjacentScanIsKeptEvenWithLowOverlap) {
-  const auto fitness = [](PairIndex) { return 0.1; };
-  EXPECT_THAT(RunPlanner(3, 0.7, fitness, 2), ElementsAre(PairIndex{1, 0}, PairIndex{2, 1}));
+  const auto overlap = [](PairIndex) { return 0.1; };
+  EXPECT_THAT(RunPlanner(3, 0.7, overlap, 2), ElementsAre(PairIndex{1, 0}, PairIndex{2, 1}));
 }
 
 TEST(KeyframePlanner, RejectsBadArguments) {

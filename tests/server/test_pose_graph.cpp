@@ -84,6 +84,115 @@ TEST(OptimizePoseGraph, LoopClosureSpreadsOdometryDrift) {
   EXPECT_TRUE(optimised.kept.back());
 }
 
+// Largest translation error over the poses, metres.
+double MaxTranslationError(const std::vector<Transform>& poses,
+                           const std::vector<Transform>& truth) {
+  double worst = 0.0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    worst = std::max(worst, TranslationErrorM(poses[i], truth[i]));
+  }
+  return worst;
+}
+
+// The circle's odometry chain 0->1->...->7 plus the loop closure 7->0. The
+// information is shaped like PairInformation's: rotation weighs the square
+// of the points' spread (here 10 m) times the translation's.
+std::vector<PairConstraint> CircleWithLoop(const std::vector<Transform>& truth) {
+  InformationMatrix information = InformationMatrix::Identity();
+  information.topLeftCorner<3, 3>() *= 100.0;
+  std::vector<PairConstraint> constraints;
+  for (int i = 0; i + 1 < 8; ++i)
+    constraints.push_back({{i, i + 1}, Relative(truth[i + 1], truth[i]), information});
+  constraints.push_back({{7, 0}, Relative(truth[0], truth[7]), information});
+  return constraints;
+}
+
+TEST(ChainPoses, PrefersATrustedAlternativeToADoubtfulEdge) {
+  const std::vector<Transform> truth = {Pose(0, 0, 0), Pose(0, 2, 0), Pose(0, 4, 0), Pose(0, 6, 0)};
+  std::vector<PairConstraint> constraints = {
+      {{0, 1}, Relative(truth[1], truth[0])},
+      // Listed first but wrong by 2 m, and marked doubtful.
+      {{1, 2},
+       Transform(Relative(truth[2], truth[1]) * Pose(0, 2, 0)),
+       InformationMatrix::Identity(),
+       0.1},
+      {{2, 3}, Relative(truth[3], truth[2])},
+      {{0, 2}, Relative(truth[2], truth[0])},  // a trusted skip over the doubtful pair
+  };
+  const ChainedPoses chained = ChainPoses(4, constraints);
+  EXPECT_FALSE(chained.in_tree[1]);
+  EXPECT_TRUE(chained.in_tree[3]);
+  EXPECT_EQ(chained.loop_closures, 1);
+  EXPECT_LT(MaxTranslationError(chained.poses, truth), 1e-9);
+}
+
+TEST(ChainPoses, ChainsADoubtfulEdgeWhenNothingElseConnects) {
+  const std::vector<Transform> truth = {Pose(0, 0, 0), Pose(0, 2, 0)};
+  const ChainedPoses chained =
+      ChainPoses(2, {{{0, 1}, Relative(truth[1], truth[0]), InformationMatrix::Identity(), 0.0}});
+  EXPECT_TRUE(chained.in_tree[0]);
+  EXPECT_LT(MaxTranslationError(chained.poses, truth), 1e-9);
+}
+
+TEST(OptimizePoseGraph, LowConfidenceWrongEdgeIsOutvotedByTheLoop) {
+  const std::vector<Transform> truth = Circle();
+  std::vector<PairConstraint> constraints = CircleWithLoop(truth);
+  // Odometry edge 3->4 is wrong.
+  constraints[3].T_target_source = Transform(constraints[3].T_target_source * Pose(0.02, 0.3, 0));
+  PoseGraphOptions options;
+  options.max_correspondence_distance = 2.0;  // no edge is pruned in any of the runs
+
+  auto optimise = [&](double wrong_confidence, double loop_confidence) {
+    std::vector<PairConstraint> weighted = constraints;
+    weighted[3].confidence = wrong_confidence;
+    weighted.back().confidence = loop_confidence;
+    const ChainedPoses chained = ChainPoses(8, weighted, truth[0]);
+    const OptimizedPoses optimised =
+        OptimizePoseGraph(chained.poses, weighted, chained.in_tree, options);
+    for (size_t e = 0; e < weighted.size(); ++e) EXPECT_TRUE(optimised.kept[e]) << e;
+    return MaxTranslationError(optimised.poses, truth);
+  };
+  const double trusted = optimise(1.0, 1.0);  // the error spreads over every edge
+  EXPECT_GT(trusted, 0.05);
+  // Most of the error goes where the doubt is: with a trusted loop closure
+  // (which then chains in its place) and with a doubtful but likelier one
+  // (the wrong edge stays in the tree, weighted down). In a loop of 8 the
+  // other 7 edges still take 7 / (7 + 1 / 0.01) of it.
+  EXPECT_LT(optimise(0.01, 1.0), 0.3 * trusted);
+  EXPECT_LT(optimise(0.01, 0.45), 0.4 * trusted);
+}
+
+TEST(OptimizePoseGraph, DoubtfulLoopClosureThatDisagreesIsPruned) {
+  const std::vector<Transform> truth = Circle();
+  std::vector<PairConstraint> constraints = CircleWithLoop(truth);
+  // A wrong loop closure, close enough that the line process alone keeps it.
+  constraints.back().T_target_source =
+      Transform(constraints.back().T_target_source * Pose(0.0, 0.4, 0.0));
+
+  const ChainedPoses chained = ChainPoses(8, constraints, truth[0]);
+  const OptimizedPoses trusted = OptimizePoseGraph(chained.poses, constraints, chained.in_tree, {});
+  ASSERT_TRUE(trusted.kept.back());
+  EXPECT_GT(MaxTranslationError(trusted.poses, truth), 0.05);
+
+  constraints.back().confidence = 0.2;
+  const OptimizedPoses doubtful =
+      OptimizePoseGraph(chained.poses, constraints, chained.in_tree, {});
+  EXPECT_FALSE(doubtful.kept.back());
+  EXPECT_LT(MaxTranslationError(doubtful.poses, truth), 1e-6);
+}
+
+TEST(OptimizePoseGraph, DoubtfulLoopClosureThatAgreesIsKept) {
+  const std::vector<Transform> truth = Circle();
+  std::vector<PairConstraint> constraints = CircleWithLoop(truth);
+  constraints.back().confidence = 0.2;
+  const ChainedPoses chained = ChainPoses(8, constraints, truth[0]);
+  const OptimizedPoses optimised =
+      OptimizePoseGraph(chained.poses, constraints, chained.in_tree, {});
+  EXPECT_TRUE(optimised.kept.back());
+  EXPECT_GT(optimised.line_process.back(), 0.9);
+  EXPECT_LT(MaxTranslationError(optimised.poses, truth), 1e-6);
+}
+
 TEST(PairInformation, GrowsWithOverlap) {
   const Points world = MakeSyntheticStreet(3, 10.0);
   const Points scan = SimulateScan(world, Pose(0, 0, 0), 20.0, 0.0, 1);

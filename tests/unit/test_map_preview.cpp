@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <open3d/geometry/Image.h>
 #include <open3d/io/ImageIO.h>
+#include <Eigen/Geometry>
 
 #include "../support/files_and_processes.hpp"
 #include "boicp/map_preview.hpp"
@@ -84,6 +85,32 @@ TEST(MapPreview, ColoursByHeightWithTrajectoryMarks) {
   }
   EXPECT_TRUE(green);
   EXPECT_TRUE(red);
+}
+
+TEST(MapPreview, LooksDownAlongTheGivenUp) {
+  // The floor-and-wall room as a depth camera's frame holds it: the room's
+  // up (z) becomes +y there, its y becomes -z.
+  const Eigen::Matrix3d camera =
+      Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  OccupiedCells tilted = FloorAndWall();
+  for (Point& c : tilted.centres) c = camera * c;
+  PreviewOptions options;
+  options.size_px = 400;
+  const RgbImage room = RenderTopDown(FloorAndWall(), {}, options);
+  const RgbImage side_on = RenderTopDown(tilted, {}, options);
+  options.up = camera * Eigen::Vector3d::UnitZ();
+  const RgbImage from_above = RenderTopDown(tilted, {}, options);
+
+  auto differing = [](const RgbImage& a, const RgbImage& b) {
+    if (a.width != b.width || a.height != b.height) return 1.0;
+    size_t count = 0;
+    for (size_t i = 0; i < a.pixels.size(); i += 3) count += a.pixels[i] != b.pixels[i];
+    return static_cast<double>(count) / static_cast<double>(a.pixels.size() / 3);
+  };
+  EXPECT_LT(differing(from_above, room), 0.01) << "the same floor plan as the upright room";
+  EXPECT_GT(differing(side_on, room), 0.1) << "seen along z it is a side view";
+  options.up = Eigen::Vector3d::Zero();
+  EXPECT_THROW(RenderTopDown(tilted, {}, options), InputError);
 }
 
 TEST(MapPreview, RefusesNothingToDrawAndTinySizes) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "boicp/auto_settings.hpp"
@@ -49,6 +50,10 @@ std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans
 /// The keyframe overlap threshold of a batch: that of its first non-depth
 /// scan's format (0.7), or 0.6 when every scan is a depth image.
 double BatchOverlapThreshold(const std::vector<ScanSource>& scans);
+
+/// The closing line of a batch: "2 of 40 pairs doubtful" (doubtful =
+/// confidence below kDoubtfulBelow).
+std::string DoubtfulSummary(int doubtful, int total);
 
 /// Pose-graph options matching how RegisterBatchPair computed the
 /// information matrices (correspondences within the inlier distance).

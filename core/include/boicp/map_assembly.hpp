@@ -34,13 +34,17 @@ struct PoseEstimate {
   std::vector<Transform> poses;  // T_map_scan
   bool optimised = false;        // a pose graph was optimised (loops closed)
   int loop_closures = 0;
-  std::vector<bool> kept;  // per constraint: used by the final poses (pruned loop closures: false)
+  /// Per constraint: used by the final poses (false for loop closures the
+  /// optimisation pruned or, being doubtful, left out).
+  std::vector<bool> kept;
 };
 
-/// Chains the constraints (listed with the sequential chain first) into
-/// poses and, when some close loops, optimises the pose graph. The map frame
-/// is scan 0's prior world frame when scan 0 has a prior pose, else scan 0's
-/// own frame. Throws InputError when the constraints leave a scan unreached.
+/// Chains the constraints (listed with the sequential chain first; trusted
+/// ones before doubtful ones, see ChainPoses) into poses and, when some
+/// close loops, optimises the pose graph with each edge weighted by its
+/// confidence (OptimizePoseGraph). The map frame is scan 0's prior world
+/// frame when scan 0 has a prior pose, else scan 0's own frame. Throws
+/// InputError when the constraints leave a scan unreached.
 PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
                            const std::vector<PairConstraint>& constraints,
                            const PoseGraphOptions& options);

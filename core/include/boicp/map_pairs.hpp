@@ -45,13 +45,16 @@ double DefaultOverlapThreshold(CloudFormat format);
 
 /// Keyframe selection by overlap. Every scan j after the current keyframe k
 /// is registered onto it (pair source = j, target = k) and its overlap is
-/// the registration's fitness. While the overlap stays at or above the
-/// threshold the scan hangs off k. When scan j falls below it, scan j-1
-/// becomes the next keyframe and j is registered onto that one instead (the
-/// probe j -> k is dropped). A scan adjacent to its keyframe is always kept,
+/// the registration's overlap estimate (RegistrationResult::overlap: the
+/// fraction of j within 1.5 search voxels of k; raw fitness counts only
+/// points within the tight inlier distance, so sensor noise and a loose fine
+/// alignment lower it without less being seen). While the overlap stays at
+/// or above the threshold the scan hangs off k. When scan j falls below it,
+/// scan j-1 becomes the next keyframe and j is registered onto that one
+/// instead (the probe j -> k is dropped). A scan adjacent to its keyframe is always kept,
 /// however small its overlap, so the chain never breaks.
 ///
-/// Decisions depend only on the fitness values recorded, never on the order
+/// Decisions depend only on the overlap values recorded, never on the order
 /// they arrive in, so a resumed batch makes the same choices. Probes can run
 /// ahead (NextProbes); those beyond a keyframe change are wasted but harmless.
 class KeyframePlanner {
@@ -63,10 +66,11 @@ class KeyframePlanner {
   /// keyframe, in scan order. Empty when the plan needs results first or is done.
   std::vector<PairIndex> NextProbes(int max_count);
 
-  /// Records a finished probe's fitness (in [0, 1]) and advances the plan as
-  /// far as the recorded results allow. Results for pairs the plan no longer
-  /// needs are kept but change nothing.
-  void Record(const PairIndex& pair, double fitness);
+  /// Records a finished probe's overlap estimate (in [0, 1]; results stored
+  /// before overlap was computed pass their fitness) and advances the plan
+  /// as far as the recorded results allow. Results for pairs the plan no
+  /// longer needs are kept but change nothing.
+  void Record(const PairIndex& pair, double overlap);
 
   /// True once every scan hangs off a keyframe.
   bool Done() const { return next_ >= num_scans_; }
@@ -85,7 +89,7 @@ class KeyframePlanner {
   int keyframe_ = 0;
   int next_ = 1;        // first scan not yet attached
   int next_probe_ = 1;  // first scan not yet handed out as a probe onto keyframe_
-  std::map<PairIndex, double> fitness_;
+  std::map<PairIndex, double> overlap_;
   std::vector<PairIndex> chain_;
 };
 

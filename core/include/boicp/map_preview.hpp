@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "boicp/map_up.hpp"
 #include "boicp/types.hpp"
 
 namespace boicp {
@@ -32,15 +33,19 @@ struct RgbImage {
 
 struct PreviewOptions {
   int size_px = 1024;  // the longer side of the image, >= 64
+  /// The map's up direction (map frame, non-zero); the picture looks down
+  /// along it. z leaves the map's x to the right and y to the top.
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
 };
 
-/// Renders the cells from above (x to the right, y up), each coloured by its
-/// height on a blue-to-red scale (the "turbo" colour map, without its dark ends) stretched between
+/// Renders the cells from above, looking down along -options.up (the map's
+/// x, laid flat, to the right), each coloured by its height along up on a
+/// blue-to-red scale (the "turbo" colour map, without its dark ends) stretched between
 /// the 2nd and 98th percentile of the heights, higher cells over lower ones.
 /// A colour bar on the right shows the scale (low at the bottom). The
 /// trajectory (positions in the map frame, may be empty) is a white line
 /// with a green square at its start and a red one at its end. Throws
-/// InputError when there is nothing to draw or size_px < 64.
+/// InputError when there is nothing to draw, size_px < 64 or up is zero.
 RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,
                        const PreviewOptions& options = {});
 
@@ -48,9 +53,12 @@ RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,
 /// rename. Throws std::runtime_error naming the file on failure.
 void WritePng(const std::string& path, const RgbImage& image);
 
-/// ReadOccupiedCells + RenderTopDown + WritePng, with the trajectory taken
-/// from the translations of `poses` (T_map_scan).
-void WriteMapPreview(const std::string& octomap_path, const std::vector<Transform>& poses,
-                     const std::string& png_path, const PreviewOptions& options = {});
+/// ReadOccupiedCells + DetectUp + RenderTopDown along the detected up +
+/// WritePng, with the trajectory taken from the translations of `poses`
+/// (T_map_scan). Returns the up direction used and why (options.up is
+/// ignored).
+UpDirection WriteMapPreview(const std::string& octomap_path, const std::vector<Transform>& poses,
+                            const std::string& png_path, const PreviewOptions& options = {},
+                            const UpDetectionOptions& up_options = {});
 
 }  // namespace boicp

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "boicp/bo_icp.hpp"
 #include "boicp/map_pairs.hpp"
 #include "boicp/types.hpp"
 
@@ -21,7 +22,13 @@ struct PairConstraint {
   /// Weight of the edge in the optimisation; Open3D's convention (rotation
   /// first, then translation), as PairInformation computes it.
   InformationMatrix information = InformationMatrix::Identity();
+  /// The pair's estimated probability of being right, in [0, 1]
+  /// (RegistrationResult::confidence); 1 = fully trusted.
+  double confidence = 1.0;
 };
+
+/// True when the constraint's confidence is below kDoubtfulBelow.
+bool IsDoubtfulEdge(const PairConstraint& constraint);
 
 /// Poses T_map_scan from chaining, and which constraints the chain used.
 struct ChainedPoses {
@@ -33,10 +40,12 @@ struct ChainedPoses {
 };
 
 /// Chains the constraints into poses with T_map_scan0 = `anchor`: a spanning
-/// tree is grown from the constraints in the order given (so a sequential
-/// chain listed first is preferred over loop closures), and each pose
-/// follows T_map_source = T_map_target * T_target_source along it. Throws
-/// InputError when a scan is not reached.
+/// tree is grown from the trusted constraints in the order given (so a
+/// sequential chain listed first is preferred over loop closures), then
+/// from the doubtful ones, so a doubtful pair is chained only where no
+/// trusted one connects the same parts. Each pose follows T_map_source =
+/// T_map_target * T_target_source along the tree. Throws InputError when a
+/// scan is not reached.
 ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constraints,
                         const Transform& anchor = Transform::Identity());
 
@@ -47,17 +56,34 @@ struct PoseGraphOptions {
   double edge_prune_threshold = 0.25;    // loop closures weighted below this are dropped
   double preference_loop_closure = 1.0;  // Open3D: <1 trusts the tree more, >1 the loops
   int max_iterations = 100;
+  /// A doubtful loop closure joins the optimisation only when the initial
+  /// poses agree with it: its starting line-process weight under them,
+  /// (mu / (mu + r^2))^2 at full information (1 = exact agreement), must be
+  /// at least this.
+  double doubtful_keep_threshold = 0.5;
 };
+
+/// The smallest factor a tree edge's information is scaled by, so the
+/// optimisation stays well posed when a pair's confidence is 0.
+constexpr double kMinEdgeWeight = 1e-3;
 
 struct OptimizedPoses {
   std::vector<Transform> poses;  // T_map_scan, scan 0 unchanged
   std::vector<bool> kept;        // per constraint: false if pruned as an outlier loop closure
+  /// Per constraint: Open3D's final line-process weight in [0, 1] (1 for
+  /// tree edges, 0 for pruned or left-out loop closures).
+  std::vector<double> line_process;
 };
 
-/// Optimises the poses over all constraints. Tree edges (in_tree) are
-/// trusted; the others are loop closures that Open3D's line process may
-/// down-weight and prune. Preconditions: `initial` has one pose per scan
-/// and in_tree one flag per constraint.
+/// Optimises the poses over all constraints, each edge's information
+/// scaled by its confidence (at least kMinEdgeWeight), so a doubtful edge
+/// gives way to the trusted ones around it. Tree edges (in_tree) are
+/// certain; the others are loop closures that Open3D's line process may
+/// down-weight and prune, starting from their confidence. A doubtful loop
+/// closure the initial poses disagree with (doubtful_keep_threshold) is left
+/// out. With every confidence 1 this is Open3D's optimisation unchanged.
+/// Preconditions: `initial` has one pose per scan and in_tree one flag per
+/// constraint; a constraint naming a scan outside `initial` throws InputError.
 OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
                                  const std::vector<PairConstraint>& constraints,
                                  const std::vector<bool>& in_tree, const PoseGraphOptions& options);
