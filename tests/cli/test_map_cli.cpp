@@ -329,8 +329,8 @@ TEST_F(MapCli, SevenScenesWithNoFlagsFollowsTheReferencePoses) {
     const Transform reference =
         folder.reference_poses[i - 1]->inverse() * *folder.reference_poses[i];
     const Transform error = reference.inverse() * (poses[i - 1].inverse() * poses[i]);
-    std::fprintf(stderr, "7-Scenes pair %zu->%zu: %.3f m, %.2f deg from the reference\n", i - 1,
-                 i, TranslationNorm(error), RotationAngle(error) * 180 / M_PI);
+    std::fprintf(stderr, "7-Scenes pair %zu->%zu: %.3f m, %.2f deg from the reference\n", i - 1, i,
+                 TranslationNorm(error), RotationAngle(error) * 180 / M_PI);
     EXPECT_LT(TranslationNorm(error), 0.05) << "pair " << i - 1 << "->" << i;
     EXPECT_LT(RotationAngle(error), 2.0 * M_PI / 180) << "pair " << i - 1 << "->" << i;
   }

@@ -121,10 +121,10 @@ TEST_F(Cli, MissingRequiredFlagAndHelp) {
   EXPECT_EQ(Run("register --source x.pcd").exit_code, 2);
   const RunResult help = Run("register --help");
   EXPECT_EQ(help.exit_code, 0);
-  for (const char* flag : {"--voxel", "--translation-bounds", "--rotation-bounds", "--format",
-                           "--intrinsics", "--intrinsics-file", "--depth-scale", "--prior",
-                           "--config", "--mode", "--seed", "--json", "--fixed-settings",
-                           "--no-retry"}) {
+  for (const char* flag :
+       {"--voxel", "--translation-bounds", "--rotation-bounds", "--format", "--intrinsics",
+        "--intrinsics-file", "--depth-scale", "--prior", "--config", "--mode", "--seed", "--json",
+        "--fixed-settings", "--no-retry"}) {
     EXPECT_THAT(help.out, HasSubstr(flag));
   }
 }
