@@ -28,15 +28,33 @@ void FsyncPath(const std::string& path, int flags) {
 
 constexpr const char* kSubdirs[] = {"scans", "jobs", "tmp"};
 
+void FsyncDirectory(const fs::path& dir) {
+  FsyncPath(dir.empty() ? "." : dir.string(), O_RDONLY | O_DIRECTORY);
+}
+
+// create_directories, with each new directory's entry synced into its
+// parent, so that a power cut cannot take back a directory whose files were
+// already reported stored.
+void CreateDurableDirectories(const fs::path& dir) {
+  if (dir.empty() || fs::is_directory(dir)) return;
+  CreateDurableDirectories(dir.parent_path());
+  std::error_code error;
+  fs::create_directory(dir, error);
+  if (error) {
+    throw StorageError("cannot create " + dir.string() + " (" + error.message() + ")");
+  }
+  FsyncDirectory(dir.parent_path());
+}
+
 }  // namespace
 
 DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_normal().string()) {
   for (const char* sub : kSubdirs) {
-    std::error_code error;
-    fs::create_directories(fs::path(root_) / sub, error);
-    if (error) {
-      throw StorageError("data directory " + root_ + ": cannot create " + sub + "/ (" +
-                         error.message() + ")");
+    try {
+      CreateDurableDirectories(fs::path(root_) / sub);
+    } catch (const StorageError& e) {
+      throw StorageError("data directory " + root_ + ": cannot create " + sub + "/ (" + e.what() +
+                         ")");
     }
   }
   const std::string lock_path = (fs::path(root_) / "lock").string();
@@ -95,14 +113,18 @@ std::string DataDir::NewTempPath() {
       .string();
 }
 
+std::string DataDir::CreateJobDir(const std::string& job_id) const {
+  const std::string dir = JobDir(job_id);
+  CreateDurableDirectories(dir);
+  return dir;
+}
+
 void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) const {
   const fs::path target = ScanPath(scan_id);
+  CreateDurableDirectories(target.parent_path());
   std::error_code error;
-  fs::create_directories(target.parent_path(), error);
-  if (!error) {
-    FsyncPath(tmp_path, O_RDONLY);
-    fs::rename(tmp_path, target, error);
-  }
+  FsyncPath(tmp_path, O_RDONLY);
+  fs::rename(tmp_path, target, error);
   if (error) {
     throw StorageError("cannot store scan " + scan_id.substr(0, 12) + " in " + root_ + " (" +
                        error.message() + ")");

@@ -250,7 +250,7 @@ void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t 
 
 }  // namespace
 
-void RequireSafePcdHeader(const std::string& path) {
+void RequireSafePcdHeader(const std::string& path, uint64_t max_points) {
   PcdHeader header;
   const uint64_t data_offset = ReadHeaderLines(path, &header);
   std::error_code ec;
@@ -258,6 +258,7 @@ void RequireSafePcdHeader(const std::string& path) {
   if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
   ParseFields(path, &header);
   ParseSizes(path, &header);
+  RequirePointCount(path, header.points, max_points);
   RequireDecodableXyz(path, header);
   RequireDataFits(path, header, data_offset, static_cast<uint64_t>(file_size) - data_offset);
 }

@@ -113,5 +113,71 @@ TEST_F(Limits, QueuedJobs) {
   client.Cancel(first);
 }
 
+// Settings that would make one job allocate or compute without bound are
+// refused at submission, naming the field and its limit.
+TEST_F(Limits, JobSettingsHaveUpperBounds) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const std::vector<std::string> ids = UploadDrive(client, 2, 31);
+  const std::vector<std::pair<std::function<void(v1::SubmitBatchRequest&)>, std::string>> cases = {
+      {[](auto& r) { r.mutable_config()->set_random_samples(1000000); },
+       "config.random_samples: 1000000 is over the limit of 1000"},
+      {[](auto& r) { r.mutable_config()->set_iterations(1000000); },
+       "config.iterations: 1000000 is over the limit of 1000"},
+      {[](auto& r) { r.mutable_config()->set_evaluation_points(4000000000u); },
+       "config.evaluation_points: 4000000000 is over the limit of 1000000"},
+      {[](auto& r) { r.mutable_config()->mutable_translation_bounds()->set_x(1e9); },
+       "config.translation_bounds.x: 1e+09 is over the limit of 1000"},
+      {[](auto& r) { r.mutable_map()->set_resolution(0.001); },
+       "map.resolution: 0.001 is under the limit of 0.01"},
+      {[](auto& r) { r.mutable_map()->set_max_range(1e6); },
+       "map.max_range: 1e+06 is over the limit of 1000"},
+      {[](auto& r) {
+         r.mutable_map()->set_resolution(0.01);
+         r.mutable_map()->set_max_range(0.0);
+       },
+       "over the limit of 20000"},
+      {[](auto& r) { r.mutable_map()->set_cloud_voxel(1e-6); },
+       "map.cloud_voxel: 1e-06 is under the limit of 0.01"},
+      {[](auto& r) { r.set_label(std::string(10000, 'x')); },
+       "label: 10000 bytes is over the limit of 256"}};
+  for (const auto& [change, message] : cases) {
+    v1::SubmitBatchRequest request = QuickBatch(ids);
+    change(request);
+    const grpc::Status status = StatusOf([&] { client.Submit(request); });
+    EXPECT_EQ(status.error_code(), Code::INVALID_ARGUMENT) << message;
+    EXPECT_THAT(status.error_message(), HasSubstr(message));
+  }
+  EXPECT_EQ(client.ListJobs().jobs_size(), 0) << "a job over a limit was queued";
+}
+
+// page_size is unsigned: 2^31 and more must clamp, not turn into a negative
+// SQL limit (-1 lists nothing, other negatives list everything).
+TEST_F(Limits, PageSizesOf2To31AndMoreClampToTheMaximum) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const std::string job_id = client.Submit(QuickBatch(UploadDrive(client, 2, 33))).job_id();
+  for (const uint32_t size : {0x80000000u, 0xfffffffeu, 0xffffffffu}) {
+    const v1::ListJobsResponse page = client.ListJobs(size);
+    ASSERT_EQ(page.jobs_size(), 1) << "page_size " << size;
+    EXPECT_EQ(page.jobs(0).job_id(), job_id);
+  }
+  client.Cancel(job_id);
+}
+
+// A label is free text: in the log it stays on its own line, escaped.
+TEST_F(Limits, LabelsAreEscapedInTheLog) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  v1::SubmitBatchRequest request = QuickBatch(UploadDrive(client, 2, 35));
+  request.set_label("survey\nFORGED error boicpd: fake line\x1b[2J");
+  const std::string job_id = client.Submit(request).job_id();
+  client.Cancel(job_id);
+  const std::string log = daemon_->Log();
+  EXPECT_THAT(log, HasSubstr("label 'survey\\nFORGED error boicpd: fake line\\x1b[2J'"));
+  EXPECT_EQ(log.find("\nFORGED"), std::string::npos) << log;
+  EXPECT_EQ(client.GetJob(job_id).label(), request.label()) << "the label itself is kept";
+}
+
 }  // namespace
 }  // namespace boicp::test
