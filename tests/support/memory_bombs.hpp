@@ -9,6 +9,7 @@
 #include <zlib.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -141,6 +142,7 @@ struct MeasuredRun {
 /// returns its exit code and peak resident memory (ru_maxrss of the child).
 inline MeasuredRun RunMeasured(const std::vector<std::string>& argv,
                                const std::filesystem::path& err_path) {
+  std::fflush(nullptr);  // else the child's freopen writes the parent's buffered output again
   const pid_t pid = ::fork();
   if (pid == 0) {
     if (!std::freopen("/dev/null", "w", stdout) || !std::freopen(err_path.c_str(), "w", stderr)) {
