@@ -114,8 +114,7 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.tls_client_ca.empty() || !o.tls_cert.empty(), "--tls-client-ca needs --tls-cert");
   require(o.max_concurrent_uploads >= 1 && o.max_concurrent_uploads <= 10000,
           "--max-concurrent-uploads must be in 1..10000");
-  require(o.max_upload_bytes_in_flight >= o.max_scan_bytes,
-          "--max-upload-bytes-in-flight must be at least --max-scan-bytes");
+  require(o.max_upload_bytes_in_flight >= 16, "--max-upload-bytes-in-flight must be at least 16");
   require(o.max_concurrent_streams >= 1, "--max-concurrent-streams must be at least 1");
   require(o.grpc_memory_mb >= 16, "--grpc-memory-mb must be at least 16");
   require(o.keepalive_s >= 1 && o.keepalive_timeout_s >= 1 && o.idle_connection_s >= 1,

@@ -28,33 +28,40 @@ void FsyncPath(const std::string& path, int flags) {
 
 constexpr const char* kSubdirs[] = {"scans", "jobs", "tmp"};
 
-void FsyncDirectory(const fs::path& dir) {
-  FsyncPath(dir.empty() ? "." : dir.string(), O_RDONLY | O_DIRECTORY);
+std::error_code SyncDirectory(const fs::path& dir) {
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return {errno, std::generic_category()};
+  const int rc = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  return rc == 0 ? std::error_code() : std::error_code(error, std::generic_category());
 }
 
 // create_directories, with each new directory's entry synced into its
 // parent, so that a power cut cannot take back a directory whose files were
-// already reported stored.
-void CreateDurableDirectories(const fs::path& dir) {
-  if (dir.empty() || fs::is_directory(dir)) return;
-  CreateDurableDirectories(dir.parent_path());
+// already reported stored. Returns the first error.
+std::error_code CreateDurableDirectories(const fs::path& dir) {
   std::error_code error;
-  fs::create_directory(dir, error);
-  if (error) {
+  if (dir.empty() || fs::exists(dir, error)) return error;
+  error = CreateDurableDirectories(dir.parent_path());
+  if (!error) fs::create_directory(dir, error);
+  if (!error) error = SyncDirectory(dir.parent_path());
+  return error;
+}
+
+void RequireDurableDirectories(const fs::path& dir) {
+  if (const std::error_code error = CreateDurableDirectories(dir)) {
     throw StorageError("cannot create " + dir.string() + " (" + error.message() + ")");
   }
-  FsyncDirectory(dir.parent_path());
 }
 
 }  // namespace
 
 DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_normal().string()) {
   for (const char* sub : kSubdirs) {
-    try {
-      CreateDurableDirectories(fs::path(root_) / sub);
-    } catch (const StorageError& e) {
-      throw StorageError("data directory " + root_ + ": cannot create " + sub + "/ (" + e.what() +
-                         ")");
+    if (const std::error_code error = CreateDurableDirectories(fs::path(root_) / sub)) {
+      throw StorageError("data directory " + root_ + ": cannot create " + sub + "/ (" +
+                         error.message() + ")");
     }
   }
   const std::string lock_path = (fs::path(root_) / "lock").string();
@@ -115,13 +122,13 @@ std::string DataDir::NewTempPath() {
 
 std::string DataDir::CreateJobDir(const std::string& job_id) const {
   const std::string dir = JobDir(job_id);
-  CreateDurableDirectories(dir);
+  RequireDurableDirectories(dir);
   return dir;
 }
 
 void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) const {
   const fs::path target = ScanPath(scan_id);
-  CreateDurableDirectories(target.parent_path());
+  RequireDurableDirectories(target.parent_path());
   std::error_code error;
   FsyncPath(tmp_path, O_RDONLY);
   fs::rename(tmp_path, target, error);

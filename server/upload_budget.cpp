@@ -6,7 +6,12 @@
 
 namespace boicp::server {
 
-uint64_t UploadBudget::Reserve(uint64_t bytes) {
+uint64_t UploadBudget::bytes_in_flight() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return bytes_;
+}
+
+void UploadBudget::Reserve(uint64_t bytes) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (uploads_ >= max_uploads_) {
     throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
@@ -23,7 +28,6 @@ uint64_t UploadBudget::Reserve(uint64_t bytes) {
   }
   ++uploads_;
   bytes_ += bytes;
-  return bytes_;
 }
 
 void UploadBudget::Release(uint64_t bytes) {

@@ -20,28 +20,28 @@ class UploadBudget {
   /// ServiceError RESOURCE_EXHAUSTED naming the limit reached, to destruction.
   class Ticket {
    public:
-    Ticket(UploadBudget& budget, uint64_t bytes)
-        : budget_(budget), bytes_(bytes), in_flight_bytes_(budget.Reserve(bytes)) {}
+    Ticket(UploadBudget& budget, uint64_t bytes) : budget_(budget), bytes_(bytes) {
+      budget.Reserve(bytes);
+    }
     ~Ticket() { budget_.Release(bytes_); }
     Ticket(const Ticket&) = delete;
     Ticket& operator=(const Ticket&) = delete;
 
-    /// Bytes announced by every upload in flight when this one started, itself included.
-    uint64_t in_flight_bytes() const { return in_flight_bytes_; }
-
    private:
     UploadBudget& budget_;
     uint64_t bytes_;
-    uint64_t in_flight_bytes_;
   };
 
+  /// Bytes announced by the uploads in flight.
+  uint64_t bytes_in_flight() const;
+
  private:
-  uint64_t Reserve(uint64_t bytes);
+  void Reserve(uint64_t bytes);
   void Release(uint64_t bytes);
 
   const int max_uploads_;
   const uint64_t max_bytes_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   int uploads_ = 0;
   uint64_t bytes_ = 0;
 };

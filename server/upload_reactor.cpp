@@ -123,8 +123,10 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
                              std::to_string(deps_.max_scan_bytes) + " (--max-scan-bytes)");
     }
   }
-  ticket_.emplace(deps_.uploads, known_ ? 0 : metadata.size_bytes());
-  RequireStorage(deps_.data_dir, deps_.min_free_bytes, ticket_->in_flight_bytes());
+  // The other uploads in flight still have their announced bytes to write.
+  const uint64_t incoming = known_ ? 0 : metadata.size_bytes();
+  RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight() + incoming);
+  ticket_.emplace(deps_.uploads, incoming);
   if (!known_) {
     temp_path_ = deps_.data_dir.NewTempPath();
     temp_.open(temp_path_, std::ios::binary | std::ios::trunc);

@@ -98,10 +98,7 @@ TEST_F(Limits, QueuedJobs) {
   StartDaemon({"--workers", "1", "--jobs", "1", "--max-queued-jobs", "1"});
   auto client = Client();
   // Full preset C: slow enough that the first job is still running below.
-  v1::SubmitBatchRequest slow = QuickBatch(UploadDrive(client, 3, 81));
-  slow.mutable_config()->set_preset("C");
-  slow.mutable_config()->clear_random_samples();
-  slow.mutable_config()->clear_iterations();
+  const v1::SubmitBatchRequest slow = SlowBatch(UploadDrive(client, 3, 81));
   const std::string first = client.Submit(slow).job_id();
   PollJob(
       client, first, [](const v1::Job& j) { return j.state() == v1::JOB_STATE_RUNNING; }, 30);
@@ -177,6 +174,38 @@ TEST_F(Limits, LabelsAreEscapedInTheLog) {
   EXPECT_THAT(log, HasSubstr("label 'survey\\nFORGED error boicpd: fake line\\x1b[2J'"));
   EXPECT_EQ(log.find("\nFORGED"), std::string::npos) << log;
   EXPECT_EQ(client.GetJob(job_id).label(), request.label()) << "the label itself is kept";
+}
+
+// Uploads streaming at once are bounded, in number and in announced bytes.
+TEST_F(Limits, UploadsInFlight) {
+  StartDaemon(
+      {"--workers", "1", "--max-concurrent-uploads", "1", "--max-upload-bytes-in-flight", "1000"});
+  auto client = Client();
+  grpc::ClientContext context;
+  v1::UploadScanResponse response;
+  auto open_upload = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, XyzScan(3).size());
+  ASSERT_TRUE(open_upload->Write(message));
+  // Until the server has read that metadata a second upload may still pass
+  // (and then the first may be the one refused): retry until one is refused.
+  grpc::Status status;
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)});
+    if (!status.ok()) break;
+  }
+  EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("(--max-concurrent-uploads 1)"));
+  message.set_chunk(XyzScan(3));
+  open_upload->Write(message);
+  open_upload->WritesDone();
+  open_upload->Finish();
+
+  const std::string big = XyzScan(200);  // over 1000 bytes
+  status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, big.size()), {big});
+  EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("(--max-upload-bytes-in-flight)"));
+  EXPECT_TRUE(RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)}).ok());
 }
 
 }  // namespace

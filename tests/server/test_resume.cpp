@@ -105,11 +105,7 @@ TEST_F(Resume, SigtermDrainsCheckpointsAndExitsThenResumes) {
 TEST_F(Resume, JobTheDaemonDiedInTwiceFailsInsteadOfResuming) {
   StartDaemon({"--workers", "1"});
   auto client = Client();
-  v1::SubmitBatchRequest slow = QuickBatch(UploadDrive(client, 3, 41));
-  slow.mutable_config()->set_preset("C");
-  slow.mutable_config()->clear_random_samples();
-  slow.mutable_config()->clear_iterations();
-  const std::string job_id = client.Submit(slow).job_id();
+  const std::string job_id = client.Submit(SlowBatch(UploadDrive(client, 3, 41))).job_id();
   for (int death = 0; death < 2; ++death) {
     // This daemon's own log says it runs the job (the store said RUNNING already).
     const v1::Job running = PollJob(

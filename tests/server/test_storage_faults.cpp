@@ -66,6 +66,17 @@ void ExecOnDatabase(const fs::path& database, const std::string& sql) {
 
 class StorageFaults : public ServerTest {
  protected:
+  // Every update of the jobs table matching `when` (SQL over OLD and NEW)
+  // fails, as on a failing disk, until RemoveJobUpdateFault.
+  void InjectJobUpdateFault(const std::string& when) const {
+    ExecOnDatabase(data_dir_ / "boicpd.sqlite",
+                   "CREATE TRIGGER injected_fault BEFORE UPDATE ON jobs WHEN " + when +
+                       " BEGIN SELECT RAISE(ABORT, 'injected storage fault'); END");
+  }
+  void RemoveJobUpdateFault() const {
+    ExecOnDatabase(data_dir_ / "boicpd.sqlite", "DROP TRIGGER injected_fault");
+  }
+
   fs::path ScanFile(const std::string& id) const {
     return data_dir_ / "scans" / id.substr(0, 2) / id;
   }
@@ -150,16 +161,13 @@ TEST_F(StorageFaults, StoreFailingDuringRegistrationFailsTheJobAndLeavesNoTaskBe
   auto client = Client();
   const auto ids = UploadDrive(client, 6, 23);
   // Every progress update of a running job fails; its final state still stores.
-  ExecOnDatabase(data_dir_ / "boicpd.sqlite",
-                 "CREATE TRIGGER injected_fault BEFORE UPDATE ON jobs "
-                 "WHEN OLD.state = 2 AND NEW.state = 2 "
-                 "BEGIN SELECT RAISE(ABORT, 'injected storage fault'); END");
+  InjectJobUpdateFault("OLD.state = 2 AND NEW.state = 2");
   const v1::Job failed = client.Watch(client.Submit(QuickBatch(ids)).job_id());
   EXPECT_EQ(failed.state(), v1::JOB_STATE_FAILED);
   EXPECT_THAT(failed.error(), HasSubstr("injected storage fault"));
   EXPECT_EQ(client.GetJob(failed.job_id()).state(), v1::JOB_STATE_FAILED);
 
-  ExecOnDatabase(data_dir_ / "boicpd.sqlite", "DROP TRIGGER injected_fault");
+  RemoveJobUpdateFault();
   const v1::Job done = client.Watch(client.Submit(QuickBatch(ids)).job_id());
   EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
   daemon_->Signal(SIGTERM);
@@ -173,9 +181,7 @@ TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
   StartDaemon({"--workers", "2"});
   auto client = Client();
   const auto ids = UploadDrive(client, 3, 25);
-  ExecOnDatabase(data_dir_ / "boicpd.sqlite",
-                 "CREATE TRIGGER injected_fault BEFORE UPDATE ON jobs WHEN NEW.state = 3 "
-                 "BEGIN SELECT RAISE(ABORT, 'injected storage fault'); END");
+  InjectJobUpdateFault("NEW.state = 3");  // SUCCEEDED
   const std::string job_id = client.Submit(QuickBatch(ids)).job_id();
   PollJob(
       client, job_id,
@@ -187,7 +193,7 @@ TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
   EXPECT_EQ(client.GetJob(job_id).state(), v1::JOB_STATE_RUNNING);
   EXPECT_EQ(client.ListJobs().jobs(0).state(), v1::JOB_STATE_RUNNING);
 
-  ExecOnDatabase(data_dir_ / "boicpd.sqlite", "DROP TRIGGER injected_fault");
+  RemoveJobUpdateFault();
   StartDaemon({"--workers", "2"});
   client = Client();
   const v1::Job done = client.Watch(job_id);
