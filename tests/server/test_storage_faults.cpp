@@ -13,7 +13,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <fstream>
+#include <thread>
 
 #include <gmock/gmock.h>
 
@@ -183,6 +185,17 @@ TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
   const auto ids = UploadDrive(client, 3, 25);
   InjectJobUpdateFault("NEW.state = 3");  // SUCCEEDED
   const std::string job_id = client.Submit(QuickBatch(ids)).job_id();
+  std::atomic<bool> watcher_saw_success{false};
+  std::thread watcher([&] {
+    auto own = Client();
+    try {
+      own.Watch(job_id, [&](const v1::JobEvent& e) {
+        if (e.job().state() == v1::JOB_STATE_SUCCEEDED) watcher_saw_success = true;
+      });
+    } catch (const client::RpcError&) {
+      // The stream ends with this daemon.
+    }
+  });
   PollJob(
       client, job_id,
       [&](const v1::Job&) {
@@ -195,6 +208,8 @@ TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
 
   RemoveJobUpdateFault();
   StartDaemon({"--workers", "2"});
+  watcher.join();
+  EXPECT_FALSE(watcher_saw_success) << "a watcher was told SUCCEEDED that was never stored";
   client = Client();
   const v1::Job done = client.Watch(job_id);
   EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
