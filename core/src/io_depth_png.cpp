@@ -83,11 +83,11 @@ void RequirePlausiblePngSize(const std::string& path, uint64_t max_points) {
   if (width * height > kMaxDepthPixels) {
     throw InputError(path + ": depth PNG of " + size + " pixels is over the 64-megapixel limit");
   }
-  RequirePointCount(path, width * height, max_points);  // a point per pixel at most
   if ((width * height * channels * bit_depth + 7) / 8 > kDeflateMaxExpansion * file_size) {
     throw InputError(path + ": corrupt PNG (" + size + " pixels cannot fit in " +
                      std::to_string(file_size) + " bytes)");
   }
+  RequirePointCount(path, width * height, max_points);  // a point per pixel at most
 }
 
 open3d::geometry::Image ReadSixteenBitGrey(const std::string& path, uint64_t max_points) {

@@ -258,9 +258,9 @@ void RequireSafePcdHeader(const std::string& path, uint64_t max_points) {
   if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
   ParseFields(path, &header);
   ParseSizes(path, &header);
-  RequirePointCount(path, header.points, max_points);
   RequireDecodableXyz(path, header);
   RequireDataFits(path, header, data_offset, static_cast<uint64_t>(file_size) - data_offset);
+  RequirePointCount(path, header.points, max_points);
 }
 
 }  // namespace boicp::io_detail
