@@ -60,8 +60,8 @@ TEST_F(MemoryBombsCli, MapRefusesAFolderHoldingABomb) {
   const fs::path folder = dir_ / "scans";
   fs::create_directories(folder);
   fs::copy_file(dir_ / "source.xyz", folder / "a.xyz");
-  fs::copy_file(dir_ / "bomb.pcd", folder / "b.pcd");
-  ExpectRefused("map with a PCD bomb",
+  fs::copy_file(dir_ / "bomb.xyz", folder / "b.xyz");  // one format a folder
+  ExpectRefused("map with an XYZ bomb",
                 {BOICP_CLI_PATH, "map", folder.string(), "-o", (dir_ / "out").string()});
 }
 
