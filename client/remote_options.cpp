@@ -72,6 +72,11 @@ void AddRemoteOptions(CLI::App& app, RemoteFlags& flags) {
                  "File holding the bearer token (the daemon's --auth-token-file)");
   app.add_option("--tls-ca", flags.tls_ca,
                  "PEM root certificates of a TLS daemon (else plaintext)");
+  app.add_option("--tls-cert", flags.tls_cert,
+                 "PEM client certificate, for a daemon run with --tls-client-ca");
+  app.add_option("--tls-key", flags.tls_key, "PEM private key of --tls-cert");
+  app.add_flag("--insecure", flags.insecure,
+               "Send --token-file's token without TLS (readable by anyone on the path)");
 }
 
 Daemon ConnectToDaemon(const RemoteFlags& flags) {
@@ -82,9 +87,24 @@ Daemon ConnectToDaemon(const RemoteFlags& flags) {
     options.token = Trim(ReadFileOrThrow(flags.token_file, "--token-file"));
     if (options.token.empty()) throw InputError("--token-file " + flags.token_file + ": empty");
   }
+  if (!options.token.empty() && flags.tls_ca.empty() && !flags.insecure) {
+    throw InputError(
+        "--token-file: the token would cross the network in plaintext; give --tls-ca "
+        "CA.pem, or --insecure to send it anyway");
+  }
   if (!flags.tls_ca.empty()) {
     ReadFileOrThrow(flags.tls_ca, "--tls-ca");  // a clear error before Connect's generic one
     options.tls_ca_file = flags.tls_ca;
+  }
+  if (flags.tls_cert.empty() != flags.tls_key.empty()) {
+    throw InputError("--tls-cert and --tls-key go together");
+  }
+  if (!flags.tls_cert.empty()) {
+    if (flags.tls_ca.empty()) throw InputError("--tls-cert needs --tls-ca");
+    ReadFileOrThrow(flags.tls_cert, "--tls-cert");
+    ReadFileOrThrow(flags.tls_key, "--tls-key");
+    options.tls_cert_file = flags.tls_cert;
+    options.tls_key_file = flags.tls_key;
   }
   Daemon daemon;
   daemon.channel = client::Connect(options);

@@ -26,10 +26,13 @@ struct RemoteFlags {
   std::string server = "127.0.0.1:50051";  // HOST:PORT
   std::string token_file;                  // bearer token (the daemon's --auth-token-file)
   std::string tls_ca;                      // PEM roots; empty = plaintext
+  std::string tls_cert, tls_key;           // client certificate for a mutual-TLS daemon
+  bool insecure = false;                   // allows the token over plaintext
 };
 
 /// Adds --server (default: env BOICP_SERVER, then 127.0.0.1:50051),
-/// --token-file and --tls-ca.
+/// --token-file, --tls-ca, --tls-cert/--tls-key (mutual TLS) and --insecure
+/// (the token may go without TLS only with it).
 void AddRemoteOptions(CLI::App& app, RemoteFlags& flags);
 
 /// A channel to the daemon and a client on it whose unary calls carry

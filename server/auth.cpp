@@ -59,12 +59,18 @@ grpc::Status BearerAuth::Check(const grpc::ServerContextBase& context) const {
 }
 
 std::shared_ptr<grpc::ServerCredentials> MakeServerCredentials(const std::string& cert_path,
-                                                               const std::string& key_path) {
-  if (cert_path.empty() && key_path.empty()) return grpc::InsecureServerCredentials();
+                                                               const std::string& key_path,
+                                                               const std::string& client_ca_path) {
+  if (cert_path.empty() && key_path.empty() && client_ca_path.empty()) {
+    return grpc::InsecureServerCredentials();
+  }
   if (cert_path.empty() || key_path.empty()) {
     throw std::runtime_error("TLS needs both --tls-cert and --tls-key");
   }
-  grpc::SslServerCredentialsOptions options;
+  grpc::SslServerCredentialsOptions options(
+      client_ca_path.empty() ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
+                             : GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+  if (!client_ca_path.empty()) options.pem_root_certs = ReadFile(client_ca_path, "TLS client CA");
   options.pem_key_cert_pairs.push_back(
       {ReadFile(key_path, "TLS key"), ReadFile(cert_path, "TLS certificate")});
   return grpc::SslServerCredentials(options);

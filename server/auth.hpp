@@ -29,10 +29,12 @@ class BearerAuth {
   std::optional<std::string> token_;
 };
 
-/// TLS credentials from PEM files, or insecure ones when both paths are
-/// empty. Throws std::runtime_error for an unreadable file or when only one
-/// of the two is given.
-std::shared_ptr<grpc::ServerCredentials> MakeServerCredentials(const std::string& cert_path,
-                                                               const std::string& key_path);
+/// TLS credentials from PEM files, or insecure ones when every path is
+/// empty. With `client_ca_path`, clients must present a certificate that CA
+/// signed (mutual TLS). Throws std::runtime_error for an unreadable file or
+/// when the certificate or its key is missing.
+std::shared_ptr<grpc::ServerCredentials> MakeServerCredentials(
+    const std::string& cert_path, const std::string& key_path,
+    const std::string& client_ca_path = "");
 
 }  // namespace boicp::server

@@ -4,6 +4,7 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/resource_quota.h>
 #include <grpcpp/server_builder.h>
 #include <spdlog/spdlog.h>
 
@@ -16,11 +17,25 @@ bool IsLoopback(const std::string& host) {
   return host == "127.0.0.1" || host == "localhost" || host == "[::1]" || host == "::1";
 }
 
+// Bounds what clients can hold open: gRPC's memory, calls per connection,
+// connections that stopped answering or sit idle.
+void ApplyTransportLimits(const DaemonOptions& o, grpc::ServerBuilder& builder) {
+  grpc::ResourceQuota quota("boicpd");
+  quota.Resize(static_cast<size_t>(o.grpc_memory_mb << 20));
+  builder.SetResourceQuota(quota);
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, o.max_concurrent_streams);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, o.keepalive_s * 1000);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, o.keepalive_timeout_s * 1000);
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, o.idle_connection_s * 1000);
+}
+
 }  // namespace
 
 Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   if (!options_.auth_token_file.empty()) auth_ = BearerAuth::FromFile(options_.auth_token_file);
-  auto credentials = MakeServerCredentials(options_.tls_cert, options_.tls_key);
+  auto credentials =
+      MakeServerCredentials(options_.tls_cert, options_.tls_key, options_.tls_client_ca);
 
   data_dir_ = std::make_unique<DataDir>(options_.data_dir);
   const uint64_t min_free_bytes = options_.min_free_mb << 20;
@@ -36,9 +51,11 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_options.max_scan_points = options_.max_scan_points;
   manager_options.min_free_bytes = min_free_bytes;
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
+  uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
+                                            options_.max_upload_bytes_in_flight);
   service_ = std::make_unique<MapBuilderService>(
-      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, options_.max_scan_bytes,
-                  options_.max_scan_points, min_free_bytes});
+      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_,
+                  options_.max_scan_bytes, options_.max_scan_points, min_free_bytes});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -47,6 +64,7 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   builder.AddListeningPort(options_.listen, credentials, &port);
   builder.RegisterService(service_.get());
   builder.SetMaxReceiveMessageSize(options_.max_message_bytes);
+  ApplyTransportLimits(options_, builder);
   server_ = builder.BuildAndStart();
   if (!server_ || port == 0) {
     throw std::runtime_error("cannot listen on " + options_.listen +
@@ -69,22 +87,31 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
       options_.max_queued_jobs, options_.max_batch_scans, options_.max_message_bytes,
       options_.max_scan_bytes, options_.max_scan_points, options_.min_free_mb);
   spdlog::info("auth {}, TLS {}", auth_.enabled() ? "on" : "off",
-               options_.tls_cert.empty() ? "off" : "on");
+               options_.tls_cert.empty()        ? "off"
+               : options_.tls_client_ca.empty() ? "on"
+                                                : "on, client certificates required");
   spdlog::info("listening on {}", address_);
 }
 
 Daemon::~Daemon() { Shutdown(); }
 
-void Daemon::Shutdown() {
-  if (stopped_) return;
+bool Daemon::Shutdown() {
+  if (stopped_) return jobs_stopped_;
   stopped_ = true;
   spdlog::info("draining: no new jobs; running jobs stop at their next checkpoint");
   if (auto* health = server_->GetHealthCheckService()) health->SetServingStatus(false);
-  manager_->Drain();
-  watches_->CloseAll(grpc::Status(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down"));
   const auto grace = std::chrono::duration_cast<std::chrono::milliseconds>(
       std::chrono::duration<double>(options_.shutdown_grace_s));
-  server_->Shutdown(std::chrono::system_clock::now() + grace);
+  const auto deadline = std::chrono::system_clock::now() + grace;
+  jobs_stopped_ = manager_->Drain(grace);
+  if (!jobs_stopped_) {
+    spdlog::warn(
+        "a job is still stopping after {} s (--shutdown-grace); it resumes at the next "
+        "start",
+        options_.shutdown_grace_s);
+  }
+  watches_->CloseAll(grpc::Status(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down"));
+  server_->Shutdown(deadline);
   server_->Wait();
   try {
     store_->Checkpoint();
@@ -92,6 +119,7 @@ void Daemon::Shutdown() {
     spdlog::warn("database checkpoint failed: {}", e.what());
   }
   spdlog::info("stopped");
+  return jobs_stopped_;
 }
 
 }  // namespace boicp::server

@@ -34,8 +34,10 @@ class Daemon {
   /// Graceful drain: reports NOT_SERVING, refuses new jobs, stops running
   /// jobs at their next checkpoint (finished pairs are stored; the jobs
   /// resume at the next start), ends watch streams, waits up to the grace
-  /// period for open calls, and checkpoints the database. Idempotent.
-  void Shutdown();
+  /// period for open calls, and checkpoints the database. Returns false when
+  /// a job was still stopping after the grace period: the caller then exits
+  /// without waiting for it (the job resumes at the next start). Idempotent.
+  bool Shutdown();
 
  private:
   DaemonOptions options_;
@@ -44,10 +46,12 @@ class Daemon {
   std::unique_ptr<JobStore> store_;
   std::unique_ptr<WatchHub> watches_;
   std::unique_ptr<JobManager> manager_;
+  std::unique_ptr<UploadBudget> uploads_;
   std::unique_ptr<MapBuilderService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::string address_;
   bool stopped_ = false;
+  bool jobs_stopped_ = false;
 };
 
 }  // namespace boicp::server

@@ -50,12 +50,41 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "refuses new scans and batches (0 = only a full disk)")
       ->capture_default_str()
       ->envname("BOICPD_MIN_FREE_MB");
+  app.add_option("--max-concurrent-uploads", o.max_concurrent_uploads,
+                 "Uploads streaming at once; more is RESOURCE_EXHAUSTED")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_CONCURRENT_UPLOADS");
+  app.add_option("--max-upload-bytes-in-flight", o.max_upload_bytes_in_flight,
+                 "Bytes the uploads streaming at once may announce together")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_UPLOAD_BYTES_IN_FLIGHT");
+  app.add_option("--max-concurrent-streams", o.max_concurrent_streams,
+                 "Calls open at once on one client connection")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_CONCURRENT_STREAMS");
+  app.add_option("--grpc-memory-mb", o.grpc_memory_mb, "MiB gRPC may use for its buffers")
+      ->capture_default_str()
+      ->envname("BOICPD_GRPC_MEMORY_MB");
+  app.add_option("--keepalive", o.keepalive_s, "Seconds between keepalive pings of a connection")
+      ->capture_default_str()
+      ->envname("BOICPD_KEEPALIVE");
+  app.add_option("--keepalive-timeout", o.keepalive_timeout_s,
+                 "Seconds a keepalive ping may go unanswered before the connection closes")
+      ->capture_default_str()
+      ->envname("BOICPD_KEEPALIVE_TIMEOUT");
+  app.add_option("--idle-connection", o.idle_connection_s,
+                 "Seconds a connection without calls stays open")
+      ->capture_default_str()
+      ->envname("BOICPD_IDLE_CONNECTION");
   app.add_option("--auth-token-file", o.auth_token_file,
                  "Require 'authorization: Bearer <token>' with the token in this file")
       ->envname("BOICPD_AUTH_TOKEN_FILE");
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (TLS on with --tls-key)")
       ->envname("BOICPD_TLS_CERT");
   app.add_option("--tls-key", o.tls_key, "PEM private key")->envname("BOICPD_TLS_KEY");
+  app.add_option("--tls-client-ca", o.tls_client_ca,
+                 "PEM CA: require client certificates it signed (mutual TLS; needs --tls-cert)")
+      ->envname("BOICPD_TLS_CLIENT_CA");
   app.add_option("--shutdown-grace", o.shutdown_grace_s,
                  "Seconds SIGTERM waits for open calls before cancelling them")
       ->capture_default_str()
@@ -82,9 +111,25 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.min_free_mb <= (uint64_t{1} << 40), "--min-free-mb must be at most 2^40");
   require(o.shutdown_grace_s >= 0.0, "--shutdown-grace must be >= 0");
   require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");
+  require(o.tls_client_ca.empty() || !o.tls_cert.empty(), "--tls-client-ca needs --tls-cert");
+  require(o.max_concurrent_uploads >= 1 && o.max_concurrent_uploads <= 10000,
+          "--max-concurrent-uploads must be in 1..10000");
+  require(o.max_upload_bytes_in_flight >= 16, "--max-upload-bytes-in-flight must be at least 16");
+  require(o.max_concurrent_streams >= 1, "--max-concurrent-streams must be at least 1");
+  require(o.grpc_memory_mb >= 16, "--grpc-memory-mb must be at least 16");
+  require(o.keepalive_s >= 1 && o.keepalive_timeout_s >= 1 && o.idle_connection_s >= 1,
+          "--keepalive, --keepalive-timeout and --idle-connection must be at least 1 s");
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "critical"};
   require(std::find(levels.begin(), levels.end(), o.log_level) != levels.end(),
           "--log-level must be trace, debug, info, warn, error or critical");
+}
+
+void RejectEmptyAuthTokenVariable(const char* value) {
+  if (value != nullptr && *value == '\0') {
+    throw std::invalid_argument(
+        "BOICPD_AUTH_TOKEN_FILE is set but empty: name the token file, or unset it to run "
+        "without authentication");
+  }
 }
 
 }  // namespace boicp::server

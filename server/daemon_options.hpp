@@ -20,8 +20,16 @@ struct DaemonOptions {
   uint64_t max_scan_bytes = 256ull << 20;  // per uploaded scan
   uint64_t max_scan_points = 5000000;      // per scan, after decoding (about 20 128-beam sweeps)
   uint64_t min_free_mb = 1024;  // MiB kept free in the data directory; new work is refused below
+  int max_concurrent_uploads = 8;
+  uint64_t max_upload_bytes_in_flight = 1ull << 30;  // announced by the uploads streaming at once
+  int max_concurrent_streams = 100;                  // calls open at once on one connection
+  uint64_t grpc_memory_mb = 512;                     // gRPC's own buffers (resource quota)
+  int keepalive_s = 60;                              // ping an idle connection this often
+  int keepalive_timeout_s = 20;                      // and close it when the ping is not answered
+  int idle_connection_s = 600;                       // close a connection with no call this long
   std::string auth_token_file;
   std::string tls_cert, tls_key;
+  std::string tls_client_ca;      // require client certificates signed by this CA (mutual TLS)
   double shutdown_grace_s = 5.0;  // how long SIGTERM waits for open calls
   std::string log_level = "info";
 };
@@ -31,5 +39,10 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& options);
 
 /// Throws std::invalid_argument naming the first flag out of range.
 void ValidateDaemonOptions(const DaemonOptions& options);
+
+/// Throws std::invalid_argument when BOICPD_AUTH_TOKEN_FILE is set but empty
+/// (`value` is its value, nullptr when unset): read as "no flag", it would
+/// turn authentication off without a word.
+void RejectEmptyAuthTokenVariable(const char* value);
 
 }  // namespace boicp::server

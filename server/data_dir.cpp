@@ -28,13 +28,38 @@ void FsyncPath(const std::string& path, int flags) {
 
 constexpr const char* kSubdirs[] = {"scans", "jobs", "tmp"};
 
+std::error_code SyncDirectory(const fs::path& dir) {
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return {errno, std::generic_category()};
+  const int rc = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  return rc == 0 ? std::error_code() : std::error_code(error, std::generic_category());
+}
+
+// create_directories, with each new directory's entry synced into its
+// parent, so that a power cut cannot take back a directory whose files were
+// already reported stored. Returns the first error.
+std::error_code CreateDurableDirectories(const fs::path& dir) {
+  std::error_code error;
+  if (dir.empty() || fs::exists(dir, error)) return error;
+  error = CreateDurableDirectories(dir.parent_path());
+  if (!error) fs::create_directory(dir, error);
+  if (!error) error = SyncDirectory(dir.parent_path());
+  return error;
+}
+
+void RequireDurableDirectories(const fs::path& dir) {
+  if (const std::error_code error = CreateDurableDirectories(dir)) {
+    throw StorageError("cannot create " + dir.string() + " (" + error.message() + ")");
+  }
+}
+
 }  // namespace
 
 DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_normal().string()) {
   for (const char* sub : kSubdirs) {
-    std::error_code error;
-    fs::create_directories(fs::path(root_) / sub, error);
-    if (error) {
+    if (const std::error_code error = CreateDurableDirectories(fs::path(root_) / sub)) {
       throw StorageError("data directory " + root_ + ": cannot create " + sub + "/ (" +
                          error.message() + ")");
     }
@@ -95,14 +120,18 @@ std::string DataDir::NewTempPath() {
       .string();
 }
 
+std::string DataDir::CreateJobDir(const std::string& job_id) const {
+  const std::string dir = JobDir(job_id);
+  RequireDurableDirectories(dir);
+  return dir;
+}
+
 void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) const {
   const fs::path target = ScanPath(scan_id);
+  RequireDurableDirectories(target.parent_path());
   std::error_code error;
-  fs::create_directories(target.parent_path(), error);
-  if (!error) {
-    FsyncPath(tmp_path, O_RDONLY);
-    fs::rename(tmp_path, target, error);
-  }
+  FsyncPath(tmp_path, O_RDONLY);
+  fs::rename(tmp_path, target, error);
   if (error) {
     throw StorageError("cannot store scan " + scan_id.substr(0, 12) + " in " + root_ + " (" +
                        error.message() + ")");

@@ -31,6 +31,9 @@ class DataDir {
   /// False for an id that is not a scan id.
   bool HasScanFile(const std::string& scan_id) const;
   std::string JobDir(const std::string& job_id) const;
+  /// Creates the job's directory (and any missing parent), each synced into
+  /// its parent. Returns its path. Throws StorageError.
+  std::string CreateJobDir(const std::string& job_id) const;
   /// The directories the daemon creates files in: the root (database), scans/,
   /// jobs/ and tmp/.
   std::vector<std::string> WritableDirs() const;

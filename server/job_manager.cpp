@@ -6,11 +6,18 @@
 #include <spdlog/spdlog.h>
 
 #include "job_spec.hpp"
+#include "log_text.hpp"
 #include "proto_convert.hpp"
 #include "service_error.hpp"
 #include "storage_check.hpp"
 
 namespace boicp::server {
+namespace {
+
+// Runs of one job the daemon may die in before the job is failed instead of resumed.
+constexpr int kMaxUnendedRuns = 2;
+
+}  // namespace
 
 JobManager::JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
                        const ManagerOptions& options)
@@ -37,6 +44,20 @@ void JobManager::Start() {
       store_.UpdateJob(job);
       Publish(job);
       spdlog::info("job {} cancelled (requested before the restart)", job.job_id());
+      continue;
+    }
+    if (store_.UnendedRuns(job.job_id()) >= kMaxUnendedRuns) {
+      // Resuming it again would most likely take this daemon down as well.
+      job.set_state(v1::JOB_STATE_FAILED);
+      job.set_stage("failed");
+      job.set_error(
+          "boicpd stopped unexpectedly (killed, perhaps for memory) in each of its last " +
+          std::to_string(kMaxUnendedRuns) + " runs of this job; it is not resumed again");
+      job.set_finished_at(NowSeconds());
+      job.set_eta_seconds(-1.0);
+      store_.UpdateJob(job);
+      Publish(job);
+      spdlog::error("job {} failed: {}", job.job_id(), job.error());
       continue;
     }
     spdlog::info("job {} resumes: {} of {} pairs done before the restart", job.job_id(),
@@ -105,7 +126,7 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   queue_changed_.notify_one();
   Publish(job);
   spdlog::info("job {} queued: {} scans, {} pairs planned, preset {}, label '{}'", job.job_id(),
-               job.num_scans(), job.pairs_total(), spec.config.preset, job.label());
+               job.num_scans(), job.pairs_total(), spec.config.preset, EscapeForLog(job.label()));
   return job;
 }
 
@@ -127,26 +148,34 @@ v1::Job JobManager::Cancel(const std::string& job_id) {
   }
   if (const auto running = running_.find(job_id); running != running_.end()) {
     running->second->Cancel();
-    // Stored so that a daemon killed before the job stops still cancels it.
-    job->set_cancel_requested(true);
-    store_.UpdateJob(*job);
+    // Stored so that a daemon killed before the job stops still cancels it;
+    // a job that finished meanwhile keeps its final state.
+    job = store_.RequestCancel(job_id);
     spdlog::info("job {} cancel requested", job_id);
   }
   return *job;
 }
 
-void JobManager::Drain() {
+bool JobManager::Drain(std::chrono::milliseconds timeout) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_lock<std::mutex> lock(mutex_);
     accepting_ = false;
-    if (draining_) return;
-    draining_ = true;
-    for (auto& [id, control] : running_) control->Interrupt();
+    if (!draining_) {
+      draining_ = true;
+      for (auto& [id, control] : running_) control->Interrupt();
+    }
+    queue_changed_.notify_all();
+    const auto stopped = [this] { return running_.empty(); };
+    if (timeout == std::chrono::milliseconds::max()) {
+      job_ended_.wait(lock, stopped);
+    } else if (!job_ended_.wait_for(lock, timeout, stopped)) {
+      return false;
+    }
   }
-  queue_changed_.notify_all();
   for (std::thread& slot : slots_) slot.join();
   slots_.clear();
   pool_.reset();  // every task has returned: each runner waited for its own
+  return true;
 }
 
 void JobManager::RunSlot() {
@@ -168,9 +197,26 @@ void JobManager::RunSlot() {
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot read it from the data store: {}", job_id, e.what());
     }
-    if (job) RunJob(*context_, *control, *job);
+    if (job) RunTracked(*job, *control);
     std::lock_guard<std::mutex> lock(mutex_);
     running_.erase(job_id);
+    job_ended_.notify_all();
+  }
+}
+
+// The store counts the run from its start to its end, so a run the daemon
+// died in stays counted for the next start.
+void JobManager::RunTracked(const v1::Job& job, JobControl& control) {
+  try {
+    store_.BeginRun(job.job_id());
+  } catch (const std::exception& e) {
+    spdlog::error("job {}: cannot record its run: {}", job.job_id(), e.what());
+  }
+  RunJob(*context_, control, job);
+  try {
+    store_.EndRun(job.job_id());
+  } catch (const std::exception& e) {
+    spdlog::error("job {}: cannot record the end of its run: {}", job.job_id(), e.what());
   }
 }
 

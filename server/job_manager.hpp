@@ -3,6 +3,7 @@
 // time on job-slot threads (their pairs on one shared worker pool), cancels,
 // resumes what a previous daemon left unfinished, and drains on shutdown.
 
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -59,11 +60,14 @@ class JobManager {
   v1::Job Cancel(const std::string& job_id);
 
   /// Stops accepting, interrupts running jobs (finished pairs are already
-  /// stored; they stay resumable) and joins every thread. Idempotent.
-  void Drain();
+  /// stored; they stay resumable) and joins every thread once they stopped.
+  /// Returns false, with the jobs still stopping, when that takes longer
+  /// than `timeout`. Idempotent.
+  bool Drain(std::chrono::milliseconds timeout = std::chrono::milliseconds::max());
 
  private:
   void RunSlot();
+  void RunTracked(const v1::Job& job, JobControl& control);
   void Publish(const v1::Job& job);
 
   JobStore& store_;
@@ -75,6 +79,7 @@ class JobManager {
 
   std::mutex mutex_;
   std::condition_variable queue_changed_;
+  std::condition_variable job_ended_;
   std::deque<std::string> queue_;
   std::map<std::string, std::shared_ptr<JobControl>> running_;
   bool accepting_ = false;

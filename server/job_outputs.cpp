@@ -2,6 +2,8 @@
 
 #include <filesystem>
 
+#include "storage_errors.hpp"
+
 namespace boicp::server {
 
 std::optional<std::string> ExportFileName(int format) {
@@ -38,6 +40,16 @@ void RemoveStagingFiles(const std::string& job_dir) {
     if (it->path().extension() == ".tmp") {
       std::error_code ignored;
       std::filesystem::remove(it->path(), ignored);
+    }
+  }
+}
+
+void RequireOutputsWritten(const MapOutputPaths& paths) {
+  for (const std::string* path : {&paths.octomap_bt, &paths.octomap_ot, &paths.trajectory_tum,
+                                  &paths.trajectory_kitti, &paths.cloud_ply}) {
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(*path, error)) {
+      throw StorageError(*path + ": output missing after it was written");
     }
   }
 }

@@ -21,4 +21,8 @@ MapOutputPaths JobOutputPaths(const std::string& job_dir);
 /// time, so every staging file found there is stale.
 void RemoveStagingFiles(const std::string& job_dir);
 
+/// Throws StorageError naming the first output file that is not on disk: a
+/// job is recorded SUCCEEDED only with every output in place.
+void RequireOutputsWritten(const MapOutputPaths& paths);
+
 }  // namespace boicp::server

@@ -71,6 +71,11 @@ class JobRun {
  public:
   JobRun(const RunnerContext& context, JobControl& control, v1::Job job)
       : ctx_(context), control_(control), job_(std::move(job)) {}
+  // Pair tasks refer to this run and to `control_`, which the caller frees
+  // once the run returns.
+  ~JobRun() { StopTasks(); }
+  JobRun(const JobRun&) = delete;
+  JobRun& operator=(const JobRun&) = delete;
 
   RunOutcome Run() {
     try {
@@ -79,8 +84,10 @@ class JobRun {
       if (!failure_.empty()) return End(v1::JOB_STATE_FAILED, failure_);
       return Assemble();
     } catch (const Cancelled&) {
+      StopTasks();
       return EndAfterStop();
     } catch (const std::exception& e) {
+      StopTasks();  // no pair may be stored after the job's final state
       return End(v1::JOB_STATE_FAILED, e.what());
     }
   }
@@ -155,6 +162,13 @@ class JobRun {
         return "explicit";
     }
     return "unknown";
+  }
+
+  // Asks the running pair tasks to stop and waits until none is left.
+  void StopTasks() {
+    aborting_ = true;
+    std::unique_lock<std::mutex> lock(control_.mutex);
+    control_.changed.wait(lock, [this] { return in_flight_ == 0; });
   }
 
   // ---- Registration stage ------------------------------------------------
@@ -368,8 +382,7 @@ class JobRun {
                    job_.job_id(), estimate.loop_closures, kept.size(), used.size());
     }
 
-    const std::string dir = ctx_.data_dir.JobDir(job_.job_id());
-    std::filesystem::create_directories(dir);
+    const std::string dir = ctx_.data_dir.CreateJobDir(job_.job_id());
     RemoveStagingFiles(dir);
     SetStage("fusing", 0, static_cast<uint32_t>(num_scans_));
     VerifyScans();  // fusion reads every scan again; the registrations took a while
@@ -393,6 +406,7 @@ class JobRun {
     };
     const FusionSummary summary =
         FuseScans(spec_.scans, estimate.poses, spec_.map, JobOutputPaths(dir), callbacks);
+    RequireOutputsWritten(JobOutputPaths(dir));
     spdlog::info("job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points",
                  job_.job_id(), num_scans_, summary.seconds, summary.occupied_leaves,
                  summary.cloud_points);
@@ -435,10 +449,14 @@ class JobRun {
     job_.set_finished_at(NowSeconds());
     job_.set_eta_seconds(state == v1::JOB_STATE_SUCCEEDED ? 0.0 : -1.0);
     job_.set_cancel_requested(control_.cancelled());
+    // Watchers learn a final state only once it is stored: one that was not
+    // stays RUNNING in the store, and the next daemon resumes the job.
     try {
       Persist();
     } catch (const std::exception& e) {
-      spdlog::error("job {}: cannot record the final state: {}", job_.job_id(), e.what());
+      spdlog::error("job {}: cannot record the final state {}: {}", job_.job_id(),
+                    JobStateName(state), e.what());
+      return RunOutcome::kFailed;
     }
     Publish(nullptr);
     const double took = job_.finished_at() - job_.started_at();
@@ -455,7 +473,9 @@ class JobRun {
 
   void Persist() {
     if (control_.cancelled()) job_.set_cancel_requested(true);
-    ctx_.store.UpdateJob(job_);
+    if (!ctx_.store.UpdateJob(job_)) {
+      throw std::runtime_error("the data store already holds a final state for this job");
+    }
   }
 
   void Publish(const v1::PairResult* pair) {

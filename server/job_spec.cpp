@@ -1,8 +1,10 @@
 #include "job_spec.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "boicp/batch_pair.hpp"
+#include "job_limits.hpp"
 #include "proto_convert.hpp"
 
 namespace boicp::server {
@@ -85,6 +87,7 @@ MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto) {
 JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& request,
                      const std::vector<v1::ScanMetadata>& scans, const DataDir& data_dir,
                      int registration_threads) {
+  RequireWithinJobLimits(request);
   JobSpec spec;
   spec.job_id = job_id;
   const int n = request.scan_ids_size();
@@ -98,6 +101,8 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
     ScanSource source;
     source.path = data_dir.ScanPath(request.scan_ids(i));
     source.load = LoadOptionsFromMetadata(meta);
+    // Stored scans met the point limit at upload; the job checks it at submission.
+    source.load.max_points = std::numeric_limits<uint64_t>::max();
     if (meta.has_sensor_origin()) {
       source.sensor_origin = PointFromProto(meta.sensor_origin(), field + ".sensor_origin");
     }

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "boicp/types.hpp"
+#include "proto_convert.hpp"
 
 namespace boicp::server {
 namespace {
@@ -89,6 +90,40 @@ JobStore::JobStore(const std::string& path) : db_(path) {
   db_.Exec("PRAGMA synchronous=FULL");
   db_.Exec("PRAGMA foreign_keys=ON");
   db_.Exec(kSchema);
+  AddUnendedRunsColumn();
+}
+
+// Databases made before the column existed get it, counting 0.
+void JobStore::AddUnendedRunsColumn() {
+  auto columns = db_.Prepare("SELECT name FROM pragma_table_info('jobs')");
+  while (columns.Step()) {
+    if (columns.ColumnText(0) == "unended_runs") return;
+  }
+  db_.Exec("ALTER TABLE jobs ADD COLUMN unended_runs INTEGER NOT NULL DEFAULT 0");
+}
+
+int JobStore::BeginRun(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Prepare("UPDATE jobs SET unended_runs = unended_runs + 1 WHERE job_id = ?1")
+      .Bind(1, job_id)
+      .Run();
+  return ReadUnendedRuns(job_id);
+}
+
+void JobStore::EndRun(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Prepare("UPDATE jobs SET unended_runs = 0 WHERE job_id = ?1").Bind(1, job_id).Run();
+}
+
+int JobStore::UnendedRuns(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return ReadUnendedRuns(job_id);
+}
+
+int JobStore::ReadUnendedRuns(const std::string& job_id) {
+  auto stmt = db_.Prepare("SELECT unended_runs FROM jobs WHERE job_id = ?1");
+  stmt.Bind(1, job_id);
+  return stmt.Step() ? static_cast<int>(stmt.ColumnInt(0)) : 0;
 }
 
 void JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points) {
@@ -140,21 +175,47 @@ v1::Job JobStore::CreateJob(v1::Job job, const JobInput& input) {
   return job;
 }
 
-void JobStore::UpdateJob(const v1::Job& job) {
+bool JobStore::UpdateJob(const v1::Job& job) {
   std::lock_guard<std::mutex> lock(mutex_);
+  SqliteDatabase::Transaction transaction(db_);
+  const std::optional<v1::Job> stored = ReadJob(job.job_id());
+  if (!stored || IsTerminal(stored->state())) return false;
+  v1::Job merged = job;
+  if (stored->cancel_requested()) merged.set_cancel_requested(true);
+  WriteJob(merged);
+  transaction.Commit();
+  return true;
+}
+
+std::optional<v1::Job> JobStore::RequestCancel(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  SqliteDatabase::Transaction transaction(db_);
+  std::optional<v1::Job> job = ReadJob(job_id);
+  if (!job || IsTerminal(job->state()) || job->cancel_requested()) return job;
+  job->set_cancel_requested(true);
+  WriteJob(*job);
+  transaction.Commit();
+  return job;
+}
+
+std::optional<v1::Job> JobStore::GetJob(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return ReadJob(job_id);
+}
+
+std::optional<v1::Job> JobStore::ReadJob(const std::string& job_id) {
+  auto stmt = db_.Prepare("SELECT job FROM jobs WHERE job_id = ?1");
+  stmt.Bind(1, job_id);
+  if (!stmt.Step()) return std::nullopt;
+  return Parse<v1::Job>(stmt.ColumnBlob(0), "job");
+}
+
+void JobStore::WriteJob(const v1::Job& job) {
   db_.Prepare("UPDATE jobs SET state = ?2, job = ?3 WHERE job_id = ?1")
       .Bind(1, job.job_id())
       .Bind(2, static_cast<int64_t>(job.state()))
       .BindBlob(3, Serialize(job))
       .Run();
-}
-
-std::optional<v1::Job> JobStore::GetJob(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare("SELECT job FROM jobs WHERE job_id = ?1");
-  stmt.Bind(1, job_id);
-  if (!stmt.Step()) return std::nullopt;
-  return Parse<v1::Job>(stmt.ColumnBlob(0), "job");
 }
 
 std::optional<JobInput> JobStore::GetJobInput(const std::string& job_id) {
@@ -171,6 +232,7 @@ std::optional<JobInput> JobStore::GetJobInput(const std::string& job_id) {
 }
 
 JobPage JobStore::ListJobs(int page_size, const std::string& page_token) {
+  if (page_size < 1) throw InputError("page_size: must be at least 1");
   int64_t before = INT64_MAX;
   if (!page_token.empty()) {
     size_t used = 0;

@@ -51,7 +51,13 @@ class JobStore {
   /// Assigns the job id ("job-000001", ...) and stores the job and its
   /// input in one transaction. Returns the job with its id set.
   v1::Job CreateJob(v1::Job job, const JobInput& input);
-  void UpdateJob(const v1::Job& job);
+  /// Stores `job` unless the stored job is already final (succeeded, failed,
+  /// cancelled): a final state is never overwritten, and a stored
+  /// cancel_requested stays set. Returns whether `job` was stored.
+  bool UpdateJob(const v1::Job& job);
+  /// Marks an unfinished job cancel-requested in one step. Returns the job
+  /// as stored afterwards (unchanged when already final), nullopt if unknown.
+  std::optional<v1::Job> RequestCancel(const std::string& job_id);
   std::optional<v1::Job> GetJob(const std::string& job_id);
   std::optional<JobInput> GetJobInput(const std::string& job_id);
   /// Newest first. `page_token` is opaque (empty = first page); throws
@@ -59,6 +65,14 @@ class JobStore {
   JobPage ListJobs(int page_size, const std::string& page_token);
   /// Queued and running jobs, oldest first: the work a restarted daemon resumes.
   std::vector<v1::Job> UnfinishedJobs();
+
+  /// Counts a daemon starting to run the job; returns the runs begun since
+  /// the last one that ended (so 2 means the previous daemon died running it).
+  int BeginRun(const std::string& job_id);
+  /// The run ended, by any outcome, with the daemon alive.
+  void EndRun(const std::string& job_id);
+  /// Runs begun and never ended: each one is a daemon that died running the job.
+  int UnendedRuns(const std::string& job_id);
 
   /// Stores one finished pair (replacing an earlier result for the same pair).
   void PutPair(const std::string& job_id, int plan_order, const v1::PairResult& result,
@@ -75,6 +89,11 @@ class JobStore {
   void Checkpoint();
 
  private:
+  void AddUnendedRunsColumn();
+  int ReadUnendedRuns(const std::string& job_id);
+  std::optional<v1::Job> ReadJob(const std::string& job_id);
+  void WriteJob(const v1::Job& job);
+
   std::mutex mutex_;
   SqliteDatabase db_;
 };

@@ -3,6 +3,7 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
   boicp::server::DaemonOptions options;
   boicp::server::AddDaemonOptions(app, options);
   try {
+    boicp::server::RejectEmptyAuthTokenVariable(std::getenv("BOICPD_AUTH_TOKEN_FILE"));
     app.parse(argc, argv);
     boicp::server::ValidateDaemonOptions(options);
   } catch (const CLI::ParseError& e) {
@@ -58,7 +60,11 @@ int main(int argc, char** argv) {
     int signal_number = 0;
     sigwait(&signals, &signal_number);
     spdlog::info("received {}", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
-    daemon.Shutdown();
+    if (!daemon.Shutdown()) {
+      // A job thread is still stopping; everything it finished is stored, so
+      // the process ends without waiting for it, as a kill would end it.
+      std::_Exit(0);
+    }
   } catch (const std::exception& e) {
     spdlog::error("boicpd: {}", e.what());
     return 1;

@@ -95,9 +95,10 @@ grpc::ServerUnaryReactor* MapBuilderService::ListJobs(grpc::CallbackServerContex
                                                       const v1::ListJobsRequest* request,
                                                       v1::ListJobsResponse* response) {
   return Unary(deps_, context, "ListJobs", [&] {
+    // Clamped as the unsigned field it is: a size of 2^31 or more is no negative limit.
     const int size = request->page_size() == 0
                          ? kDefaultPageSize
-                         : std::min(static_cast<int>(request->page_size()), kMaxPageSize);
+                         : static_cast<int>(std::min<uint32_t>(request->page_size(), kMaxPageSize));
     JobPage page = deps_.store.ListJobs(size, request->page_token());
     for (v1::Job& job : page.jobs) {
       if (std::optional<v1::Job> latest = deps_.watches.Latest(job.job_id())) job = *latest;

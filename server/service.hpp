@@ -10,6 +10,7 @@
 #include "data_dir.hpp"
 #include "job_manager.hpp"
 #include "job_store.hpp"
+#include "upload_budget.hpp"
 #include "watch_hub.hpp"
 
 namespace boicp::server {
@@ -22,6 +23,7 @@ struct ServiceDeps {
   JobManager& manager;
   WatchHub& watches;
   const BearerAuth& auth;
+  UploadBudget& uploads;
   uint64_t max_scan_bytes = 0;   // larger uploads are RESOURCE_EXHAUSTED
   uint64_t max_scan_points = 0;  // scans decoding to more points are RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;   // below it uploads and batches are FAILED_PRECONDITION

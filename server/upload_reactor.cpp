@@ -24,13 +24,35 @@ std::string WithoutPath(std::string message, const std::string& path) {
   return message;
 }
 
-void RequirePointLimit(size_t points, uint64_t limit) {
+void RequirePointLimit(uint64_t points, uint64_t limit) {
   if (points > limit) {
     throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
                        "scan has " + std::to_string(points) +
                            " points, over this daemon's limit of " + std::to_string(limit) +
                            " (--max-scan-points)");
   }
+}
+
+// The loaders refuse a scan over the limit from its header, before they
+// allocate its points.
+LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& metadata,
+                             uint64_t max_points) {
+  LoadOptions options = LoadOptionsFromMetadata(metadata);
+  options.max_points = max_points;
+  try {
+    return LoadPointCloud(path, options);
+  } catch (const PointLimitError& e) {
+    RequirePointLimit(e.points(), e.limit());
+    throw;
+  } catch (const InputError& e) {
+    throw InputError(WithoutPath(e.what(), path));
+  }
+}
+
+// The stored points stay valid when the new metadata reads the bytes the
+// same way (same format and camera).
+bool SameDecoding(const v1::ScanMetadata& a, const v1::ScanMetadata& b) {
+  return a.format() == b.format() && a.depth().SerializeAsString() == b.depth().SerializeAsString();
 }
 
 }  // namespace
@@ -101,7 +123,10 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
                              std::to_string(deps_.max_scan_bytes) + " (--max-scan-bytes)");
     }
   }
-  RequireStorage(deps_.data_dir, deps_.min_free_bytes, known_ ? 0 : metadata.size_bytes());
+  // The other uploads in flight still have their announced bytes to write.
+  const uint64_t incoming = known_ ? 0 : metadata.size_bytes();
+  RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight() + incoming);
+  ticket_.emplace(deps_.uploads, incoming);
   if (!known_) {
     temp_path_ = deps_.data_dir.NewTempPath();
     temp_.open(temp_path_, std::ios::binary | std::ios::trunc);
@@ -141,21 +166,21 @@ void UploadReactor::Complete() {
   if (!metadata_) throw InputError("empty upload: send metadata, then the bytes");
   v1::ScanMetadata metadata = *metadata_;
   if (known_) {
-    // The new metadata must still describe the stored bytes (a format or
-    // camera change re-parses them, which is cheap next to an upload).
-    const std::string path = deps_.data_dir.ScanPath(metadata.sha256());
-    LoadedCloud cloud;
-    try {
-      cloud = LoadPointCloud(path, LoadOptionsFromMetadata(metadata));
-    } catch (const InputError& e) {
-      throw InputError(WithoutPath(e.what(), path));
+    // The new metadata must still describe the stored bytes: a format or
+    // camera change re-parses them; the same decoding keeps the stored count.
+    const StoredScan stored = *deps_.store.GetScan(metadata.sha256());
+    uint64_t points = stored.num_points;
+    if (!SameDecoding(metadata, stored.metadata)) {
+      points = LoadUploadedScan(deps_.data_dir.ScanPath(metadata.sha256()), metadata,
+                                deps_.max_scan_points)
+                   .points.size();
     }
-    RequirePointLimit(cloud.points.size(), deps_.max_scan_points);
-    metadata.set_size_bytes(deps_.store.GetScan(metadata.sha256())->metadata.size_bytes());
-    deps_.store.PutScan(metadata, cloud.points.size());
+    RequirePointLimit(points, deps_.max_scan_points);
+    metadata.set_size_bytes(stored.metadata.size_bytes());
+    deps_.store.PutScan(metadata, points);
     response_->set_scan_id(metadata.sha256());
     response_->set_already_present(true);
-    response_->set_num_points(cloud.points.size());
+    response_->set_num_points(points);
     response_->set_size_bytes(metadata.size_bytes());
     spdlog::info("scan {} already stored; metadata updated", metadata.sha256().substr(0, 12));
     return;
@@ -175,13 +200,7 @@ void UploadReactor::Complete() {
   if (!metadata.sha256().empty() && metadata.sha256() != id) {
     throw InputError("metadata.sha256 does not match the bytes received (got " + id + ")");
   }
-  LoadedCloud cloud;
-  try {
-    cloud = LoadPointCloud(temp_path_, LoadOptionsFromMetadata(metadata));
-  } catch (const InputError& e) {
-    throw InputError(WithoutPath(e.what(), temp_path_));
-  }
-  RequirePointLimit(cloud.points.size(), deps_.max_scan_points);
+  const LoadedCloud cloud = LoadUploadedScan(temp_path_, metadata, deps_.max_scan_points);
   const bool present = deps_.data_dir.HasScanFile(id);
   if (!present) {
     deps_.data_dir.CommitScan(temp_path_, id);

@@ -3,7 +3,8 @@
 // file and hashed as they arrive. At the end the scan is parsed with the
 // core loaders (so a malformed scan is refused at upload, not mid-batch),
 // then renamed to its hash and recorded. Refused (FAILED_PRECONDITION) while
-// the data directory cannot take the announced bytes.
+// the data directory cannot take the announced bytes with those of the other
+// uploads in flight, and (RESOURCE_EXHAUSTED) over the upload budget.
 
 #include <fstream>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include "boicp/v1/map_builder.pb.h"
 #include "sha256.hpp"
+#include "upload_budget.hpp"
 
 namespace boicp::server {
 
@@ -40,6 +42,7 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   ::boicp::v1::UploadScanResponse* response_;
   ::boicp::v1::UploadScanRequest request_;
   std::optional<::boicp::v1::ScanMetadata> metadata_;
+  std::optional<UploadBudget::Ticket> ticket_;
   bool known_ = false;      // the client named a hash the store holds: bytes are not needed
   std::string corruption_;  // the stored copy of the named hash failed its check
   std::string temp_path_;

@@ -6,6 +6,15 @@
 #include "proto_convert.hpp"
 
 namespace boicp::server {
+namespace {
+
+// Events one watcher may have queued. A watcher that reads slower than the
+// job reports gets, past this, the newest snapshot in place of the last
+// queued event: a finished pair's event may give way (the pair stays in
+// GetResults, and pairs_done shows the jump), the final state never does.
+constexpr size_t kMaxPendingEvents = 64;
+
+}  // namespace
 
 // Every field below is guarded by the hub's mutex.
 class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
@@ -47,6 +56,9 @@ class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
     if (!pending.empty() && !pending.back().has_pair() && !event.has_pair() &&
         pending.back().job().stage() == event.job().stage()) {
       pending.back() = event;
+    } else if (pending.size() >= kMaxPendingEvents) {
+      pending.back() = event;
+      pending.back().clear_pair();
     } else {
       pending.push_back(event);
     }
@@ -84,7 +96,13 @@ WatchHub::~WatchHub() {
 
 void WatchHub::Publish(const v1::JobEvent& event) {
   std::lock_guard<std::mutex> lock(mutex_);
-  latest_[event.job().job_id()] = event.job();
+  // A final state is published only once stored, so the store answers for
+  // finished jobs and the cache holds only the ones still running.
+  if (IsTerminal(event.job().state())) {
+    latest_.erase(event.job().job_id());
+  } else {
+    latest_[event.job().job_id()] = event.job();
+  }
   for (Stream* stream : streams_) {
     if (stream->job_id == event.job().job_id() && !stream->finish_requested) {
       stream->Enqueue(event);

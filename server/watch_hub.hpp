@@ -32,7 +32,8 @@ class WatchHub : public JobEventSink {
 
   void Publish(const v1::JobEvent& event) override;
 
-  /// The newest snapshot published for the job, if any since the start.
+  /// The newest snapshot published for the job while it runs (a finished
+  /// job's final state is in the store), if any since the start.
   std::optional<v1::Job> Latest(const std::string& job_id) const;
 
   /// A reactor for one WatchJob call. Its first event is the newest

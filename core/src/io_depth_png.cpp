@@ -63,7 +63,7 @@ uint64_t BigEndianU32(const unsigned char* bytes) {
 // at most 1032-fold, so a header whose pixels cannot come from the file's
 // bytes is refused here, as is one over kMaxDepthPixels. Anything that is not
 // a PNG header is left to Open3D's own error.
-void RequirePlausiblePngSize(const std::string& path) {
+void RequirePlausiblePngSize(const std::string& path, uint64_t max_points) {
   constexpr uint64_t kDeflateMaxExpansion = 1032;
   constexpr uint64_t kMaxDepthPixels = uint64_t{1} << 26;  // 64 Mpx, 8192 x 8192
   static const unsigned char kSignature[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
@@ -87,10 +87,11 @@ void RequirePlausiblePngSize(const std::string& path) {
     throw InputError(path + ": corrupt PNG (" + size + " pixels cannot fit in " +
                      std::to_string(file_size) + " bytes)");
   }
+  RequirePointCount(path, width * height, max_points);  // a point per pixel at most
 }
 
-open3d::geometry::Image ReadSixteenBitGrey(const std::string& path) {
-  RequirePlausiblePngSize(path);
+open3d::geometry::Image ReadSixteenBitGrey(const std::string& path, uint64_t max_points) {
+  RequirePlausiblePngSize(path, max_points);
   open3d::geometry::Image image;
   bool ok = false;
   try {
@@ -119,9 +120,9 @@ std::vector<bool> InvalidMask(const std::vector<uint16_t>& invalid_values) {
 
 }  // namespace
 
-Points ReadDepthPng(const std::string& path, const DepthOptions& options) {
+Points ReadDepthPng(const std::string& path, const DepthOptions& options, uint64_t max_points) {
   RequireDepthOptions(path, options);
-  const open3d::geometry::Image image = ReadSixteenBitGrey(path);
+  const open3d::geometry::Image image = ReadSixteenBitGrey(path, max_points);
   const Intrinsics& k = *options.intrinsics;
   const std::vector<bool> invalid = InvalidMask(options.invalid_values);
 

@@ -26,7 +26,7 @@ float LittleEndianFloat(const unsigned char* bytes) {
 
 }  // namespace
 
-Points ReadKittiBin(const std::string& path) {
+Points ReadKittiBin(const std::string& path, uint64_t max_points) {
   std::ifstream in = OpenOrThrow(path, std::ios::in | std::ios::binary);
   std::error_code ec;
   const uintmax_t size = std::filesystem::file_size(path, ec);
@@ -37,6 +37,7 @@ Points ReadKittiBin(const std::string& path) {
                      " bytes is not a multiple of " + std::to_string(kBytesPerRow) + ")");
   }
 
+  RequirePointCount(path, size / kBytesPerRow, max_points);
   const size_t rows = static_cast<size_t>(size / kBytesPerRow);
   std::vector<unsigned char> bytes(static_cast<size_t>(size));
   if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size))) {

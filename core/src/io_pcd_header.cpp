@@ -250,7 +250,7 @@ void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t 
 
 }  // namespace
 
-void RequireSafePcdHeader(const std::string& path) {
+void RequireSafePcdHeader(const std::string& path, uint64_t max_points) {
   PcdHeader header;
   const uint64_t data_offset = ReadHeaderLines(path, &header);
   std::error_code ec;
@@ -260,6 +260,7 @@ void RequireSafePcdHeader(const std::string& path) {
   ParseSizes(path, &header);
   RequireDecodableXyz(path, header);
   RequireDataFits(path, header, data_offset, static_cast<uint64_t>(file_size) - data_offset);
+  RequirePointCount(path, header.points, max_points);
 }
 
 }  // namespace boicp::io_detail

@@ -59,7 +59,7 @@ bool IsPlyPropertyLine(const std::vector<std::string_view>& w) {
 // line by line against the PLY grammar, every line whole (RPly reads words
 // across line ends), and the vertex count may not exceed the bytes after the
 // header, since a vertex takes at least one.
-void RequirePlyHeaderFits(const std::string& path) {
+void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
   constexpr size_t kMaxHeaderLines = 1000;
   constexpr size_t kMaxHeaderLine = 1000;  // RPly's words and lines have fixed buffers
   const auto fail = [&path](const std::string& why) {
@@ -92,6 +92,7 @@ void RequirePlyHeaderFits(const std::string& path) {
         throw InputError(path + ": truncated PLY (" + std::to_string(*vertices) +
                          " vertices declared, " + std::to_string(data) + " data bytes)");
       }
+      if (vertices) RequirePointCount(path, *vertices, max_points);
       return;
     }
     if (words[0] == "property" && in_element && IsPlyPropertyLine(words)) continue;
@@ -111,13 +112,13 @@ void RequirePlyHeaderFits(const std::string& path) {
 
 }  // namespace
 
-Points ReadPcdOrPly(const std::string& path, CloudFormat format) {
+Points ReadPcdOrPly(const std::string& path, CloudFormat format, uint64_t max_points) {
   const bool is_ply = format == CloudFormat::kPly;
   const std::string name = is_ply ? "PLY" : "PCD";
   if (is_ply) {
-    RequirePlyHeaderFits(path);
+    RequirePlyHeaderFits(path, max_points);
   } else {
-    RequireSafePcdHeader(path);
+    RequireSafePcdHeader(path, max_points);
   }
 
   open3d::io::ReadPointCloudOption option;

@@ -36,14 +36,19 @@ bool IsBlankOrComment(std::string_view line);
 /// InputError "path:LINE: 'token' is not a number".
 std::vector<double> ReadNumbersFile(const std::string& path);
 
-/// Throws InputError unless `path` has a PCD v0.7 header whose declared
-/// sizes fit the file and whose x/y/z Open3D decodes (see io_pcd_header.cpp).
-void RequireSafePcdHeader(const std::string& path);
+/// Throws PointLimitError when `points` is over `max_points`.
+void RequirePointCount(const std::string& path, uint64_t points, uint64_t max_points);
 
-Points ReadKittiBin(const std::string& path);
+/// Throws InputError unless `path` has a PCD v0.7 header whose declared
+/// sizes fit the file and whose x/y/z Open3D decodes (see io_pcd_header.cpp),
+/// and PointLimitError when it declares more than `max_points` points.
+void RequireSafePcdHeader(const std::string& path, uint64_t max_points);
+
+// Each reader refuses more than `max_points` points before allocating them.
+Points ReadKittiBin(const std::string& path, uint64_t max_points);
 /// PCD or PLY through Open3D; `format` must be kPcd or kPly.
-Points ReadPcdOrPly(const std::string& path, CloudFormat format);
-Points ReadXyzText(const std::string& path);
-Points ReadDepthPng(const std::string& path, const DepthOptions& options);
+Points ReadPcdOrPly(const std::string& path, CloudFormat format, uint64_t max_points);
+Points ReadXyzText(const std::string& path, uint64_t max_points);
+Points ReadDepthPng(const std::string& path, const DepthOptions& options, uint64_t max_points);
 
 }  // namespace boicp::io_detail

@@ -78,11 +78,28 @@ void AppendNumber(double value, std::string* out) {
   out->append(buffer, result.ptr);
 }
 
+// Lines holding data (not blank, not '#'), read one at a time.
+uint64_t CountDataLines(const std::string& path) {
+  std::ifstream in = OpenOrThrow(path);
+  uint64_t count = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    count += IsBlankOrComment(line) ? 0 : 1;
+  }
+  if (in.bad()) throw InputError(path + ": read error");
+  return count;
+}
+
 }  // namespace
 
-Points ReadXyzText(const std::string& path) {
+Points ReadXyzText(const std::string& path, uint64_t max_points) {
+  // Text declares no count: the lines are counted before any point is kept.
+  const uint64_t count = CountDataLines(path);
+  RequirePointCount(path, count, max_points);
   std::ifstream in = OpenOrThrow(path);
   Points points;
+  points.reserve(static_cast<size_t>(count));
   std::string line;
   for (size_t line_number = 1; std::getline(in, line); ++line_number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();

@@ -106,12 +106,16 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   FusionSummary summary;
   summary.occupied_leaves = map.OccupiedLeaves();
   // The .ot keeps full probabilities, so it goes before the .bt conversion.
+  // A stop request is honoured between outputs too: each write is atomic,
+  // so a stopped job leaves whole files, and its rerun rewrites them all.
   if (!outputs.octomap_ot.empty()) {
     WriteFileAtomically(outputs.octomap_ot, [&](const std::string& tmp) { map.WriteFull(tmp); });
   }
+  ThrowIfStopped(callbacks);
   if (!outputs.octomap_bt.empty()) {
     WriteFileAtomically(outputs.octomap_bt, [&](const std::string& tmp) { map.WriteBinary(tmp); });
   }
+  ThrowIfStopped(callbacks);
   if (!outputs.trajectory_tum.empty()) {
     WriteText(outputs.trajectory_tum,
               [&](std::ostream& out) { WriteTumTrajectory(out, ScanTimestamps(scans), poses); });
@@ -120,6 +124,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
     WriteText(outputs.trajectory_kitti,
               [&](std::ostream& out) { WriteKittiTrajectory(out, poses); });
   }
+  ThrowIfStopped(callbacks);
   if (want_cloud) {
     const Points merged = cloud.Centroids();
     summary.cloud_points = merged.size();

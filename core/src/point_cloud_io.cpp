@@ -21,17 +21,18 @@ std::string ToLower(std::string text) {
   return text;
 }
 
-Points ReadPoints(const std::string& path, CloudFormat format, const DepthOptions& depth) {
+Points ReadPoints(const std::string& path, CloudFormat format, const LoadOptions& options) {
+  const uint64_t limit = options.max_points;
   switch (format) {
     case CloudFormat::kKittiBin:
-      return io_detail::ReadKittiBin(path);
+      return io_detail::ReadKittiBin(path, limit);
     case CloudFormat::kPcd:
     case CloudFormat::kPly:
-      return io_detail::ReadPcdOrPly(path, format);
+      return io_detail::ReadPcdOrPly(path, format, limit);
     case CloudFormat::kXyz:
-      return io_detail::ReadXyzText(path);
+      return io_detail::ReadXyzText(path, limit);
     case CloudFormat::kDepthPng:
-      return io_detail::ReadDepthPng(path, depth);
+      return io_detail::ReadDepthPng(path, options.depth, limit);
     case CloudFormat::kAuto:
       break;
   }
@@ -48,6 +49,20 @@ size_t DropNonFinite(Points* points) {
 }
 
 }  // namespace
+
+PointLimitError::PointLimitError(const std::string& path, uint64_t points, uint64_t limit)
+    : InputError(path + ": " + std::to_string(points) + " points, over the limit of " +
+                 std::to_string(limit)),
+      points_(points),
+      limit_(limit) {}
+
+namespace io_detail {
+
+void RequirePointCount(const std::string& path, uint64_t points, uint64_t max_points) {
+  if (points > max_points) throw PointLimitError(path, points, max_points);
+}
+
+}  // namespace io_detail
 
 CloudFormat ParseCloudFormat(const std::string& name) {
   const std::string key = ToLower(name);
@@ -95,7 +110,7 @@ LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options) 
   io_detail::RequireReadableFile(path);
   LoadedCloud cloud;
   cloud.format = options.format == CloudFormat::kAuto ? DetectCloudFormat(path) : options.format;
-  cloud.points = ReadPoints(path, cloud.format, options.depth);
+  cloud.points = ReadPoints(path, cloud.format, options);
   const size_t total = cloud.points.size();
   cloud.dropped_nonfinite = DropNonFinite(&cloud.points);
   if (cloud.points.empty()) {

@@ -38,6 +38,10 @@ std::shared_ptr<grpc::Channel> Connect(const ConnectOptions& options) {
   if (!options.tls_ca_file.empty()) {
     grpc::SslCredentialsOptions ssl;
     ssl.pem_root_certs = ReadAll(options.tls_ca_file);
+    if (!options.tls_cert_file.empty()) {
+      ssl.pem_cert_chain = ReadAll(options.tls_cert_file);
+      ssl.pem_private_key = ReadAll(options.tls_key_file);
+    }
     credentials = grpc::SslCredentials(ssl);
   }
   return grpc::CreateCustomChannel(options.address, credentials, arguments);

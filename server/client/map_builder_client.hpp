@@ -32,9 +32,10 @@ class RpcError : public std::runtime_error {
 };
 
 struct ConnectOptions {
-  std::string address;      // HOST:PORT
-  std::string token;        // bearer token; empty = none
-  std::string tls_ca_file;  // PEM roots; empty = plaintext
+  std::string address;                      // HOST:PORT
+  std::string token;                        // bearer token; empty = none
+  std::string tls_ca_file;                  // PEM roots; empty = plaintext
+  std::string tls_cert_file, tls_key_file;  // client certificate (mutual TLS); empty = none
   int max_message_bytes = 4 << 20;
 };
 

@@ -338,17 +338,26 @@ TEST_F(RemoteCli, TokenIsRequiredAndNeverPrinted) {
   EXPECT_EQ(Lines(missing.err).size(), 1u) << missing.err;
   EXPECT_THAT(missing.err, HasSubstr("--token-file"));
 
-  const RunResult wrong = Run("jobs --token-file " + (dir_ / "wrong").string() + server_);
+  // Without TLS the token goes only with --insecure.
+  const RunResult plaintext = Run("jobs --token-file " + (dir_ / "token").string() + server_);
+  EXPECT_EQ(plaintext.exit_code, 2);
+  EXPECT_EQ(Lines(plaintext.err).size(), 1u) << plaintext.err;
+  EXPECT_THAT(plaintext.err, HasSubstr("--insecure"));
+
+  const RunResult wrong =
+      Run("jobs --insecure --token-file " + (dir_ / "wrong").string() + server_);
   EXPECT_NE(wrong.exit_code, 0);
   EXPECT_EQ(Lines(wrong.err).size(), 1u) << wrong.err;
   EXPECT_THAT(wrong.err, HasSubstr("rejected the token"));
   EXPECT_THAT(wrong.err, Not(HasSubstr("not-the-token")));
 
-  const RunResult unreadable = Run("jobs --token-file " + (dir_ / "nope").string() + server_);
+  const RunResult unreadable =
+      Run("jobs --insecure --token-file " + (dir_ / "nope").string() + server_);
   EXPECT_EQ(unreadable.exit_code, 2);
   EXPECT_EQ(Lines(unreadable.err).size(), 1u) << unreadable.err;
 
-  const RunResult right = Run("jobs --json --token-file " + (dir_ / "token").string() + server_);
+  const RunResult right =
+      Run("jobs --json --insecure --token-file " + (dir_ / "token").string() + server_);
   EXPECT_EQ(right.exit_code, 0) << right.err;
   EXPECT_THAT(right.out + right.err, Not(HasSubstr("s3cret-token")));
 

@@ -27,6 +27,14 @@ v1::SubmitBatchRequest QuickBatch(const std::vector<std::string>& scan_ids, uint
   return request;
 }
 
+v1::SubmitBatchRequest SlowBatch(const std::vector<std::string>& scan_ids) {
+  v1::SubmitBatchRequest request = QuickBatch(scan_ids);
+  request.mutable_config()->set_preset("C");
+  request.mutable_config()->clear_random_samples();
+  request.mutable_config()->clear_iterations();
+  return request;
+}
+
 grpc::Status RawUpload(client::MapBuilderClient& client, const v1::ScanMetadata& metadata,
                        const std::vector<std::string>& chunks, const std::string& token) {
   grpc::ClientContext context;

@@ -2,10 +2,12 @@
 // up: INVALID_ARGUMENT, NOT_FOUND, UNAUTHENTICATED. Exceeded limits
 // (RESOURCE_EXHAUSTED) are in test_limits.cpp.
 
+#include <algorithm>
 #include <fstream>
 
 #include <gmock/gmock.h>
 
+#include "../support/files_and_processes.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::test {
@@ -135,11 +137,33 @@ TEST_F(BadInput, BearerTokenIsRequiredWhenConfigured) {
               Code::UNAUTHENTICATED);
     EXPECT_EQ(CodeOf([&] { client->Upload("1 2 3\n", Meta(v1::SCAN_FORMAT_XYZ, 6)); }),
               Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] { client->ListJobs(); }), Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] { client->Cancel("job-000001"); }), Code::UNAUTHENTICATED);
+    EXPECT_EQ(CodeOf([&] { client->Results("job-000001"); }), Code::UNAUTHENTICATED);
+    grpc::ClientContext context;
+    client->Authorize(context);
+    v1::FindScansRequest find;
+    find.add_scan_ids(std::string(64, 'a'));
+    v1::FindScansResponse found;
+    EXPECT_EQ(client->stub().FindScans(&context, find, &found).error_code(), Code::UNAUTHENTICATED);
   }
   EXPECT_EQ(RawUpload(anonymous, Meta(v1::SCAN_FORMAT_XYZ, 6), {"1 2 3\n"}).error_code(),
             Code::UNAUTHENTICATED);
   EXPECT_EQ(CodeOf([&] { right.GetJob("job-000001"); }), Code::NOT_FOUND);
   EXPECT_EQ(right.Upload("1 2 3\n4 5 6\n", Meta(v1::SCAN_FORMAT_XYZ, 0)).num_points(), 2u);
+}
+
+// An empty BOICPD_AUTH_TOKEN_FILE reads as "no flag" to the option parser;
+// it must stop the daemon instead of turning authentication off.
+TEST_F(BadInput, EmptyAuthTokenVariableRefusesToStart) {
+  const RunResult run =
+      RunCaptured(std::string("BOICPD_AUTH_TOKEN_FILE= timeout 60 ") + BOICPD_PATH +
+                      " --listen 127.0.0.1:0 --data-dir " + (dir_ / "data").string(),
+                  dir_);
+  const std::string output = run.out + run.err;
+  EXPECT_EQ(run.exit_code, 2) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+  EXPECT_THAT(output, HasSubstr("BOICPD_AUTH_TOKEN_FILE is set but empty"));
 }
 
 }  // namespace

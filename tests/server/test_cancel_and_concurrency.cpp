@@ -19,10 +19,7 @@ TEST_F(CancelAndConcurrency, CancelStopsARunningBatchWithinSecondsAndAQueuedOneA
   auto client = Client();
   const auto ids = UploadDrive(client, 5, 51);
   // Config C: long enough that the cancel lands mid-search.
-  v1::SubmitBatchRequest slow = QuickBatch(ids);
-  slow.mutable_config()->set_preset("C");
-  slow.mutable_config()->clear_random_samples();
-  slow.mutable_config()->clear_iterations();
+  const v1::SubmitBatchRequest slow = SlowBatch(ids);
   const std::string running = client.Submit(slow).job_id();
   const std::string queued = client.Submit(slow).job_id();
   const v1::Job started = PollJob(

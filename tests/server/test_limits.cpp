@@ -98,10 +98,7 @@ TEST_F(Limits, QueuedJobs) {
   StartDaemon({"--workers", "1", "--jobs", "1", "--max-queued-jobs", "1"});
   auto client = Client();
   // Full preset C: slow enough that the first job is still running below.
-  v1::SubmitBatchRequest slow = QuickBatch(UploadDrive(client, 3, 81));
-  slow.mutable_config()->set_preset("C");
-  slow.mutable_config()->clear_random_samples();
-  slow.mutable_config()->clear_iterations();
+  const v1::SubmitBatchRequest slow = SlowBatch(UploadDrive(client, 3, 81));
   const std::string first = client.Submit(slow).job_id();
   PollJob(
       client, first, [](const v1::Job& j) { return j.state() == v1::JOB_STATE_RUNNING; }, 30);
@@ -111,6 +108,104 @@ TEST_F(Limits, QueuedJobs) {
   EXPECT_THAT(status.error_message(), HasSubstr("(--max-queued-jobs 1)"));
   client.Cancel(second);
   client.Cancel(first);
+}
+
+// Settings that would make one job allocate or compute without bound are
+// refused at submission, naming the field and its limit.
+TEST_F(Limits, JobSettingsHaveUpperBounds) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const std::vector<std::string> ids = UploadDrive(client, 2, 31);
+  const std::vector<std::pair<std::function<void(v1::SubmitBatchRequest&)>, std::string>> cases = {
+      {[](auto& r) { r.mutable_config()->set_random_samples(1000000); },
+       "config.random_samples: 1000000 is over the limit of 1000"},
+      {[](auto& r) { r.mutable_config()->set_iterations(1000000); },
+       "config.iterations: 1000000 is over the limit of 1000"},
+      {[](auto& r) { r.mutable_config()->set_evaluation_points(4000000000u); },
+       "config.evaluation_points: 4000000000 is over the limit of 1000000"},
+      {[](auto& r) { r.mutable_config()->mutable_translation_bounds()->set_x(1e9); },
+       "config.translation_bounds.x: 1e+09 is over the limit of 1000"},
+      {[](auto& r) { r.mutable_map()->set_resolution(0.001); },
+       "map.resolution: 0.001 is under the limit of 0.01"},
+      {[](auto& r) { r.mutable_map()->set_max_range(1e6); },
+       "map.max_range: 1e+06 is over the limit of 1000"},
+      {[](auto& r) {
+         r.mutable_map()->set_resolution(0.01);
+         r.mutable_map()->set_max_range(0.0);
+       },
+       "over the limit of 20000"},
+      {[](auto& r) { r.mutable_map()->set_cloud_voxel(1e-6); },
+       "map.cloud_voxel: 1e-06 is under the limit of 0.01"},
+      {[](auto& r) { r.set_label(std::string(10000, 'x')); },
+       "label: 10000 bytes is over the limit of 256"}};
+  for (const auto& [change, message] : cases) {
+    v1::SubmitBatchRequest request = QuickBatch(ids);
+    change(request);
+    const grpc::Status status = StatusOf([&] { client.Submit(request); });
+    EXPECT_EQ(status.error_code(), Code::INVALID_ARGUMENT) << message;
+    EXPECT_THAT(status.error_message(), HasSubstr(message));
+  }
+  EXPECT_EQ(client.ListJobs().jobs_size(), 0) << "a job over a limit was queued";
+}
+
+// page_size is unsigned: 2^31 and more must clamp, not turn into a negative
+// SQL limit (-1 lists nothing, other negatives list everything).
+TEST_F(Limits, PageSizesOf2To31AndMoreClampToTheMaximum) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const std::string job_id = client.Submit(QuickBatch(UploadDrive(client, 2, 33))).job_id();
+  for (const uint32_t size : {0x80000000u, 0xfffffffeu, 0xffffffffu}) {
+    const v1::ListJobsResponse page = client.ListJobs(size);
+    ASSERT_EQ(page.jobs_size(), 1) << "page_size " << size;
+    EXPECT_EQ(page.jobs(0).job_id(), job_id);
+  }
+  client.Cancel(job_id);
+}
+
+// A label is free text: in the log it stays on its own line, escaped.
+TEST_F(Limits, LabelsAreEscapedInTheLog) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  v1::SubmitBatchRequest request = QuickBatch(UploadDrive(client, 2, 35));
+  request.set_label("survey\nFORGED error boicpd: fake line\x1b[2J");
+  const std::string job_id = client.Submit(request).job_id();
+  client.Cancel(job_id);
+  const std::string log = daemon_->Log();
+  EXPECT_THAT(log, HasSubstr("label 'survey\\nFORGED error boicpd: fake line\\x1b[2J'"));
+  EXPECT_EQ(log.find("\nFORGED"), std::string::npos) << log;
+  EXPECT_EQ(client.GetJob(job_id).label(), request.label()) << "the label itself is kept";
+}
+
+// Uploads streaming at once are bounded, in number and in announced bytes.
+TEST_F(Limits, UploadsInFlight) {
+  StartDaemon(
+      {"--workers", "1", "--max-concurrent-uploads", "1", "--max-upload-bytes-in-flight", "1000"});
+  auto client = Client();
+  grpc::ClientContext context;
+  v1::UploadScanResponse response;
+  auto open_upload = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, XyzScan(3).size());
+  ASSERT_TRUE(open_upload->Write(message));
+  // Until the server has read that metadata a second upload may still pass
+  // (and then the first may be the one refused): retry until one is refused.
+  grpc::Status status;
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)});
+    if (!status.ok()) break;
+  }
+  EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("(--max-concurrent-uploads 1)"));
+  message.set_chunk(XyzScan(3));
+  open_upload->Write(message);
+  open_upload->WritesDone();
+  open_upload->Finish();
+
+  const std::string big = XyzScan(200);  // over 1000 bytes
+  status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, big.size()), {big});
+  EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("(--max-upload-bytes-in-flight)"));
+  EXPECT_TRUE(RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)}).ok());
 }
 
 }  // namespace

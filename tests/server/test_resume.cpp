@@ -15,6 +15,7 @@ namespace boicp::test {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 double NowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -97,6 +98,32 @@ TEST_F(Resume, SigtermDrainsCheckpointsAndExitsThenResumes) {
   const v1::Job done = client.Watch(job_id);
   EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
   EXPECT_EQ(done.pairs_done(), 4u);
+}
+
+// A job the daemon died in twice (as when it is killed for memory) would
+// take every restart down again: the third start fails it, naming why.
+TEST_F(Resume, JobTheDaemonDiedInTwiceFailsInsteadOfResuming) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const std::string job_id = client.Submit(SlowBatch(UploadDrive(client, 3, 41))).job_id();
+  for (int death = 0; death < 2; ++death) {
+    // This daemon's own log says it runs the job (the store said RUNNING already).
+    const v1::Job running = PollJob(
+        client, job_id,
+        [&](const v1::Job&) {
+          return daemon_->Log().find("job " + job_id + " running") != std::string::npos;
+        },
+        120);
+    ASSERT_EQ(running.state(), v1::JOB_STATE_RUNNING);
+    daemon_->Signal(SIGKILL);
+    ASSERT_EQ(daemon_->Wait(10), 128 + SIGKILL);
+    StartDaemon({"--workers", "1"});
+    client = Client();
+  }
+  const v1::Job failed = client.GetJob(job_id);
+  EXPECT_EQ(failed.state(), v1::JOB_STATE_FAILED);
+  EXPECT_THAT(failed.error(), HasSubstr("stopped unexpectedly"));
+  EXPECT_THAT(daemon_->Log(), Not(HasSubstr("job " + job_id + " resumes")));
 }
 
 }  // namespace

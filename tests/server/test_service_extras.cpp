@@ -145,5 +145,51 @@ TEST_F(ServiceExtras, ServesOverTls) {
   }
 }
 
+// The token travels inside TLS: without it a TLS call is refused, with it it passes.
+TEST_F(ServiceExtras, TokenOverTls) {
+  const std::string key = (dir_ / "key.pem").string(), cert = (dir_ / "cert.pem").string();
+  if (!MakeSelfSignedCertificate(key, cert)) GTEST_SKIP() << "openssl is not available";
+  std::ofstream(dir_ / "token") << "s3cret-token\n";
+  StartDaemon({"--workers", "1", "--tls-cert", cert, "--tls-key", key, "--auth-token-file",
+               (dir_ / "token").string()});
+  client::ConnectOptions tls;
+  tls.address = daemon_->address();
+  tls.tls_ca_file = cert;
+  client::MapBuilderClient anonymous(client::Connect(tls));
+  client::MapBuilderClient right(client::Connect(tls), "s3cret-token");
+  EXPECT_EQ(CodeOf([&] { anonymous.ListJobs(); }), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(right.ListJobs().jobs_size(), 0);
+}
+
+// --tls-client-ca: only clients with a certificate that CA signed get in.
+TEST_F(ServiceExtras, MutualTlsRequiresAClientCertificateFromTheCa) {
+  const std::string key = (dir_ / "key.pem").string(), cert = (dir_ / "cert.pem").string();
+  const std::string client_key = (dir_ / "client-key.pem").string(),
+                    client_cert = (dir_ / "client-cert.pem").string();
+  const std::string other_key = (dir_ / "other-key.pem").string(),
+                    other_cert = (dir_ / "other-cert.pem").string();
+  if (!MakeSelfSignedCertificate(key, cert) ||
+      !MakeSelfSignedCertificate(client_key, client_cert) ||
+      !MakeSelfSignedCertificate(other_key, other_cert)) {
+    GTEST_SKIP() << "openssl is not available";
+  }
+  StartDaemon(
+      {"--workers", "1", "--tls-cert", cert, "--tls-key", key, "--tls-client-ca", client_cert});
+  client::ConnectOptions options;
+  options.address = daemon_->address();
+  options.tls_ca_file = cert;
+  client::MapBuilderClient without(client::Connect(options));
+  EXPECT_EQ(CodeOf([&] { without.ListJobs(); }), grpc::StatusCode::UNAVAILABLE);
+  options.tls_cert_file = other_cert;
+  options.tls_key_file = other_key;
+  client::MapBuilderClient stranger(client::Connect(options));
+  EXPECT_EQ(CodeOf([&] { stranger.ListJobs(); }), grpc::StatusCode::UNAVAILABLE);
+  options.tls_cert_file = client_cert;
+  options.tls_key_file = client_key;
+  client::MapBuilderClient known(client::Connect(options));
+  EXPECT_EQ(known.ListJobs().jobs_size(), 0);
+  EXPECT_THAT(daemon_->Log(), ::testing::HasSubstr("client certificates required"));
+}
+
 }  // namespace
 }  // namespace boicp::test

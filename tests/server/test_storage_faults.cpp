@@ -7,12 +7,15 @@
 #include <fcntl.h>
 #include <linux/magic.h>
 #include <signal.h>
+#include <sqlite3.h>
 #include <sys/statfs.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <fstream>
+#include <thread>
 
 #include <gmock/gmock.h>
 
@@ -26,6 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using Code = grpc::StatusCode;
 
 constexpr uint64_t kMiB = 1 << 20;
@@ -49,8 +53,32 @@ void FlipAByte(const fs::path& file) {
   stream.put(static_cast<char>(byte ^ 0x5a));
 }
 
+// Runs `sql` on the daemon's database through a second connection, the way
+// a failing disk would reach the daemon: through its own statements.
+void ExecOnDatabase(const fs::path& database, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(database.c_str(), &db), SQLITE_OK);
+  sqlite3_busy_timeout(db, 10000);
+  char* error = nullptr;
+  const int code = sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error);
+  EXPECT_EQ(code, SQLITE_OK) << (error ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
 class StorageFaults : public ServerTest {
  protected:
+  // Every update of the jobs table matching `when` (SQL over OLD and NEW)
+  // fails, as on a failing disk, until RemoveJobUpdateFault.
+  void InjectJobUpdateFault(const std::string& when) const {
+    ExecOnDatabase(data_dir_ / "boicpd.sqlite",
+                   "CREATE TRIGGER injected_fault BEFORE UPDATE ON jobs WHEN " + when +
+                       " BEGIN SELECT RAISE(ABORT, 'injected storage fault'); END");
+  }
+  void RemoveJobUpdateFault() const {
+    ExecOnDatabase(data_dir_ / "boicpd.sqlite", "DROP TRIGGER injected_fault");
+  }
+
   fs::path ScanFile(const std::string& id) const {
     return data_dir_ / "scans" / id.substr(0, 2) / id;
   }
@@ -124,6 +152,68 @@ TEST_F(StorageFaults, UnwritableWhileRunningRefusesUploadsAndBatchesThenRecovers
   const v1::Job done = client.Watch(client.Submit(QuickBatch(ids)).job_id());
   EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
   EXPECT_EQ(daemon_->Wait(0.1), -1) << "the daemon exited";
+}
+
+// Storing a running job's progress fails after its first pair, while other
+// pairs still register: the job fails naming the fault, its pair tasks stop
+// before the job's state is freed (under ASan a late task is a
+// use-after-free report), and the daemon serves the next job.
+TEST_F(StorageFaults, StoreFailingDuringRegistrationFailsTheJobAndLeavesNoTaskBehind) {
+  StartDaemon({"--workers", "2"});
+  auto client = Client();
+  const auto ids = UploadDrive(client, 6, 23);
+  // Every progress update of a running job fails; its final state still stores.
+  InjectJobUpdateFault("OLD.state = 2 AND NEW.state = 2");
+  const v1::Job failed = client.Watch(client.Submit(QuickBatch(ids)).job_id());
+  EXPECT_EQ(failed.state(), v1::JOB_STATE_FAILED);
+  EXPECT_THAT(failed.error(), HasSubstr("injected storage fault"));
+  EXPECT_EQ(client.GetJob(failed.job_id()).state(), v1::JOB_STATE_FAILED);
+
+  RemoveJobUpdateFault();
+  const v1::Job done = client.Watch(client.Submit(QuickBatch(ids)).job_id());
+  EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
+  daemon_->Signal(SIGTERM);
+  EXPECT_EQ(daemon_->Wait(60), 0) << daemon_->Log();
+  EXPECT_THAT(daemon_->Log(), Not(HasSubstr("Sanitizer")));
+}
+
+// Storing a job's final state fails: no one is told it succeeded (the store
+// still says RUNNING), and the next daemon resumes it to a stored success.
+TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
+  StartDaemon({"--workers", "2"});
+  auto client = Client();
+  const auto ids = UploadDrive(client, 3, 25);
+  InjectJobUpdateFault("NEW.state = 3");  // SUCCEEDED
+  const std::string job_id = client.Submit(QuickBatch(ids)).job_id();
+  std::atomic<bool> watcher_saw_success{false};
+  std::thread watcher([&] {
+    auto own = Client();
+    try {
+      own.Watch(job_id, [&](const v1::JobEvent& e) {
+        if (e.job().state() == v1::JOB_STATE_SUCCEEDED) watcher_saw_success = true;
+      });
+    } catch (const client::RpcError&) {
+      // The stream ends with this daemon.
+    }
+  });
+  PollJob(
+      client, job_id,
+      [&](const v1::Job&) {
+        return daemon_->Log().find("cannot record the final state") != std::string::npos;
+      },
+      300);
+  ASSERT_THAT(daemon_->Log(), HasSubstr("cannot record the final state"));
+  EXPECT_EQ(client.GetJob(job_id).state(), v1::JOB_STATE_RUNNING);
+  EXPECT_EQ(client.ListJobs().jobs(0).state(), v1::JOB_STATE_RUNNING);
+
+  RemoveJobUpdateFault();
+  StartDaemon({"--workers", "2"});
+  watcher.join();
+  EXPECT_FALSE(watcher_saw_success) << "a watcher was told SUCCEEDED that was never stored";
+  client = Client();
+  const v1::Job done = client.Watch(job_id);
+  EXPECT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
+  EXPECT_EQ(client.GetJob(job_id).state(), v1::JOB_STATE_SUCCEEDED);
 }
 
 TEST_F(StorageFaults, NearlyFullWhileRunningRefusesUploadsAndBatchesThenRecovers) {

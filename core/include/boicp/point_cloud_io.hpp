@@ -45,9 +45,26 @@ struct DepthOptions {
   std::vector<uint16_t> invalid_values = {0, 65535};  // raw values that mean "no depth"
 };
 
+/// Points a loader accepts unless told otherwise: about 120 MB of points.
+constexpr uint64_t kDefaultMaxPoints = 5000000;
+
 struct LoadOptions {
   CloudFormat format = CloudFormat::kAuto;  // kAuto: from the extension
   DepthOptions depth;
+  /// More points than this (as the header declares them, or as counted for
+  /// text) is refused before the points are allocated.
+  uint64_t max_points = kDefaultMaxPoints;
+};
+
+/// A file that declares more points than LoadOptions::max_points.
+class PointLimitError : public InputError {
+ public:
+  PointLimitError(const std::string& path, uint64_t points, uint64_t limit);
+  uint64_t points() const { return points_; }
+  uint64_t limit() const { return limit_; }
+
+ private:
+  uint64_t points_, limit_;
 };
 
 struct LoadedCloud {
@@ -56,10 +73,10 @@ struct LoadedCloud {
   CloudFormat format = CloudFormat::kAuto;  // the format actually used
 };
 
-/// Loads one cloud. Throws InputError when the file is missing or unreadable,
-/// the format is unknown or malformed (truncated .bin, bad PLY header, PNG that
-/// is not 16-bit single channel), depth options are missing, or no finite
-/// point is left.
+/// Loads one cloud. Throws PointLimitError over options.max_points, checked
+/// against the header before anything is allocated. Throws InputError when the file is missing or
+/// unreadable, the format is unknown or malformed (truncated .bin, bad PLY header, PNG that is not
+/// 16-bit single channel), depth options are missing, or no finite point is left.
 LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options = {});
 
 /// Reads a rigid transform from a text file holding 12 (3x4, row-major) or 16
