@@ -225,6 +225,9 @@ void ChooseRunSettings(LocalRun& run) {
   run.map_auto = {false, false};
   ValidateConfig(run.config);
   ValidateOccupancySettings(run.map.occupancy);
+}
+
+void PrintRunSettings(const LocalRun& run) {
   std::fprintf(
       stderr,
       "settings: voxel %.3g m, refine voxel %.3g m, translation bounds %.3g,%.3g,%.3g m, "

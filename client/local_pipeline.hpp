@@ -65,8 +65,11 @@ struct LocalRun {
 LocalRun PrepareRun(const MapSettings& settings);
 
 /// Chooses the settings the user left automatic from the run's scans
-/// (ApplyBatchSettings), once for the whole run, and prints them on stderr.
+/// (ApplyBatchSettings), once for the whole run.
 void ChooseRunSettings(LocalRun& run);
+
+/// One "settings: ..." line on stderr: the values used and which were chosen.
+void PrintRunSettings(const LocalRun& run);
 
 /// run.json: the settings as given, plus "chosen" (the settings used) and
 /// "auto" (which of them came from the scans).

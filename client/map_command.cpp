@@ -67,16 +67,19 @@ Shard ParseShard(const std::string& text) {
 }
 
 // Shards share OUTDIR/run.json: the first writes it, the others must agree.
+void CheckShardManifest(const LocalRun& run, const std::string& out) {
+  const std::string manifest = RunManifestPath(out);
+  if (!fs::exists(manifest)) return;
+  const std::string differences = ManifestDifferences(ReadRunManifest(out), run.settings);
+  if (!differences.empty()) {
+    throw InputError(manifest + " holds another run's settings (" + differences +
+                     "); use a fresh OUTDIR");
+  }
+}
+
 void ClaimShardManifest(const LocalRun& run, const std::string& out) {
   const std::string manifest = RunManifestPath(out);
-  if (fs::exists(manifest)) {
-    const std::string differences = ManifestDifferences(ReadRunManifest(out), run.settings);
-    if (!differences.empty()) {
-      throw InputError(manifest + " holds another run's settings (" + differences +
-                       "); use a fresh OUTDIR");
-    }
-    return;
-  }
+  if (fs::exists(manifest)) return;
   fs::create_directories(out);
   WriteTextFileAtomically(manifest, RunManifestJson(run).dump(1) + "\n");
 }
@@ -177,19 +180,21 @@ int RunMap(MapFlags flags) {
     settings.pairs_file = Absolute(settings.pairs_file);
     LocalRun run = PrepareRun(settings);
     const std::string& out = flags.out_dir;
-    const std::optional<Shard> shard =
-        flags.shard.empty() ? std::nullopt : std::optional<Shard>(ParseShard(flags.shard));
-    if (shard && run.keyframes) {
+    const bool sharded = !flags.shard.empty();
+    const Shard shard = sharded ? ParseShard(flags.shard) : Shard{};
+    if (sharded && run.keyframes) {
       throw InputError(
           "--shard: overlap pairing chooses its pairs as results come in; shard "
           "consecutive or explicit pairing");
     }
+    if (sharded) CheckShardManifest(run, out);
     CheckScansLoad(run.folder);
-    std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
     ChooseRunSettings(run);
-    if (shard) ClaimShardManifest(run, out);
-    if (shard) return RunShard(run, *shard, flags);
-    return BuildMap(run, flags, start);
+    std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
+    PrintRunSettings(run);
+    if (!sharded) return BuildMap(run, flags, start);
+    ClaimShardManifest(run, out);
+    return RunShard(run, shard, flags);
   } catch (const InputError& e) {
     std::cerr << "boicp map: error: " << e.what() << std::endl;
     return kBadInput;

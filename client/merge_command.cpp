@@ -48,6 +48,7 @@ int RunMerge(const MergeFlags& flags) {
     CheckScansLoad(run.folder);
     std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(),
                  run.folder.description.c_str(), records.size());
+    PrintRunSettings(run);
     std::vector<PairRecord> chain;
     for (const PairIndex& p : run.plan) chain.push_back(records.at(p));
     fs::create_directories(flags.out_dir);

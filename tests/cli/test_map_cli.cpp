@@ -351,7 +351,7 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemon) {
   test::DaemonProcess daemon(
       {"--data-dir", (dir_ / "daemon").string(), "--workers", "2", "--registration-threads", "1"},
       (dir_ / "daemon.log").string());
-  client::MapBuilderClient client(client::Connect({daemon.address(), "", "", 4 << 20}));
+  client::MapBuilderClient client(client::Connect({daemon.address(), "", "", "", "", 4 << 20}));
   namespace v1 = ::boicp::v1;
   v1::SubmitBatchRequest request;
   for (const Transform& pose : truth_) {

@@ -63,8 +63,11 @@ LoadFigures RunLoad(const LoadOptions& options, const std::string& work_dir) {
   figures.load_average_start = LoadAverage();
   figures.daemon_log = work_dir + "/boicpd.log";
   test::DaemonProcess daemon(
+      // Every client may upload at once: the load measured is the daemon's
+      // work, not its upload limit (Limits.UploadsInFlight tests that).
       {"--data-dir", work_dir + "/data", "--workers", std::to_string(options.workers), "--jobs",
-       std::to_string(options.jobs), "--registration-threads", "1"},
+       std::to_string(options.jobs), "--registration-threads", "1", "--max-concurrent-uploads",
+       std::to_string(options.clients)},
       figures.daemon_log);
   const auto memory = [&](ProcessMemory& into, const char* when) {
     std::this_thread::sleep_for(kSettle);

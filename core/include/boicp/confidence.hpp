@@ -5,7 +5,8 @@
 
 namespace boicp {
 
-/// What the engine knows about its own answer when it finishes.
+/// What the engine knows about its own answer when it finishes. The model
+/// weighs fitness and margin; the rest is reported for fitting and diagnosis.
 struct ConfidenceFeatures {
   double fitness = 0.0;     // inlier fraction at the finest level, in [0, 1]
   double rmse_ratio = 0.0;  // inlier RMSE / inlier distance, in [0, 1]
