@@ -1,9 +1,8 @@
 #include "boicp/search_space.hpp"
 
-#include "boicp/config.hpp"
-
-#include <algorithm>
 #include <cmath>
+
+#include "boicp/config.hpp"
 
 namespace boicp {
 
@@ -46,11 +45,6 @@ SearchSpace MakeSearchSpace(const Transform& anchor, const Point& pivot,
     if (space.half_widths[p] > 0.0) space.parameters.push_back(static_cast<SearchParameter>(p));
   }
   return space;
-}
-
-bool SearchSpace::SearchesRotation() const {
-  return std::any_of(parameters.begin(), parameters.end(),
-                     [](SearchParameter p) { return p < kX; });
 }
 
 }  // namespace boicp

@@ -32,9 +32,6 @@ struct SearchSpace {
 
   /// Roll and yaw wrap around when their half-width reaches pi.
   std::vector<bool> Periodic() const;
-
-  /// True when roll, pitch or yaw is among the parameters.
-  bool SearchesRotation() const;
 };
 
 /// The rotation-stage, translation-stage or joint box with non-zero
