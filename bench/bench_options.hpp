@@ -12,7 +12,7 @@
 
 #include <Eigen/Core>
 
-#include "boicp/evaluation.hpp"
+#include "boicp/registration/evaluation.hpp"
 
 namespace boicp::bench {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "boicp/point_cloud_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
 #include "seeds.hpp"
 
 namespace boicp::bench {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "boicp/evaluation.hpp"
-#include "boicp/types.hpp"
+#include "boicp/registration/evaluation.hpp"
+#include "boicp/util/types.hpp"
 #include "dataset_table.hpp"
 
 namespace boicp::bench {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "boicp/config.hpp"
+#include "boicp/registration/config.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {

@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 
 #include "bench_options.hpp"
-#include "boicp/evaluation.hpp"
+#include "boicp/registration/evaluation.hpp"
 
 namespace boicp::bench {
 

@@ -9,7 +9,7 @@
 #include <chrono>
 #include <functional>
 
-#include "boicp/bo_icp.hpp"
+#include "boicp/registration/bo_icp.hpp"
 
 namespace boicp::bench {
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fits the confidence model of core/src/confidence.cpp on bench outcomes.
+"""Fits the confidence model of core/src/registration/confidence.cpp on bench outcomes.
 
 usage: fit_confidence.py --fit CSV [CSV...] --test CSV [CSV...]
 

@@ -2,7 +2,7 @@
 
 #include <optional>
 
-#include "boicp/bo_icp.hpp"
+#include "boicp/registration/bo_icp.hpp"
 #include "dataset_config.hpp"
 #include "evaluation_clock.hpp"
 #include "methods.hpp"

@@ -12,7 +12,7 @@
 #include <open3d/pipelines/registration/Registration.h>
 #include <open3d/utility/Random.h>
 
-#include "boicp/refinement.hpp"
+#include "boicp/registration/refinement.hpp"
 #include "dataset_config.hpp"
 #include "methods.hpp"
 

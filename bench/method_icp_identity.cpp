@@ -1,7 +1,7 @@
 // icp-identity: plain ICP started from the identity, the baseline that shows
 // how far the perturbation is outside ICP's basin.
 
-#include "boicp/refinement.hpp"
+#include "boicp/registration/refinement.hpp"
 #include "dataset_config.hpp"
 #include "methods.hpp"
 

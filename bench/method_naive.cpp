@@ -12,8 +12,8 @@
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/Registration.h>
 
-#include "boicp/auto_settings.hpp"
-#include "boicp/bo_icp.hpp"
+#include "boicp/registration/auto_settings.hpp"
+#include "boicp/registration/bo_icp.hpp"
 #include "dataset_config.hpp"
 #include "methods.hpp"
 

@@ -11,10 +11,10 @@
 #include <limits>
 #include <vector>
 
-#include "boicp/alignment_score.hpp"
-#include "boicp/preprocess.hpp"
-#include "boicp/refinement.hpp"
-#include "boicp/search_space.hpp"
+#include "boicp/registration/alignment_score.hpp"
+#include "boicp/registration/preprocess.hpp"
+#include "boicp/registration/refinement.hpp"
+#include "boicp/registration/search_space.hpp"
 #include "dataset_config.hpp"
 #include "methods.hpp"
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "boicp/confidence.hpp"
-#include "boicp/config.hpp"
-#include "boicp/types.hpp"
+#include "boicp/registration/confidence.hpp"
+#include "boicp/registration/config.hpp"
+#include "boicp/util/types.hpp"
 #include "dataset_table.hpp"
 
 namespace boicp::bench {

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "boicp/evaluation.hpp"
-#include "boicp/preprocess.hpp"
+#include "boicp/registration/evaluation.hpp"
+#include "boicp/registration/preprocess.hpp"
 
 namespace boicp::bench {
 

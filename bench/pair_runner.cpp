@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <functional>
 
-#include "boicp/evaluation.hpp"
+#include "boicp/registration/evaluation.hpp"
 
 namespace boicp::bench {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "boicp/confidence.hpp"
+#include "boicp/registration/confidence.hpp"
 
 namespace boicp::bench {
 

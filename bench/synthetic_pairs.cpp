@@ -1,7 +1,7 @@
 #include <cmath>
 
 #include "bench_pairs.hpp"
-#include "boicp/synthetic_scene.hpp"
+#include "boicp/io/synthetic_scene.hpp"
 
 namespace boicp::bench {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp::cli {
 

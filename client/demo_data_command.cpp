@@ -8,9 +8,9 @@
 #include <iomanip>
 #include <iostream>
 
-#include "boicp/point_cloud_io.hpp"
-#include "boicp/synthetic_scene.hpp"
-#include "boicp/trajectory_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
+#include "boicp/io/synthetic_scene.hpp"
+#include "boicp/io/trajectory_io.hpp"
 #include "commands.hpp"
 
 namespace boicp::cli {

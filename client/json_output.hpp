@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "boicp/bo_icp.hpp"
+#include "boicp/registration/bo_icp.hpp"
 
 namespace boicp::cli {
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "boicp/atomic_file.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "json_output.hpp"
 
 namespace boicp::cli {

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "boicp/batch_pair.hpp"
+#include "boicp/mapping/batch_pair.hpp"
 
 namespace boicp::cli {
 

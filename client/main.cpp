@@ -8,7 +8,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"boicp: globally initialised ICP registration (BO-ICP) and map building"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "boicp 0.1.0");
+  app.set_version_flag("--version", "boicp " BOICP_VERSION);
   std::map<CLI::App*, boicp::cli::CommandRunner> runners;
   auto add = [&](CLI::App* sub, boicp::cli::CommandRunner run) { runners[sub] = std::move(run); };
 

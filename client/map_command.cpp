@@ -7,7 +7,7 @@
 #include <iostream>
 #include <optional>
 
-#include "boicp/atomic_file.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "commands.hpp"
 #include "local_pipeline.hpp"
 #include "map_settings_flags.hpp"

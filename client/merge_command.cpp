@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "boicp/atomic_file.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "commands.hpp"
 #include "local_pipeline.hpp"
 

@@ -4,7 +4,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 #include "commands.hpp"
 
 namespace boicp::cli {

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "boicp/map_assembly.hpp"
-#include "boicp/types.hpp"
+#include "boicp/mapping/map_assembly.hpp"
+#include "boicp/util/types.hpp"
 #include "boicp/v1/map_builder.pb.h"
 
 namespace boicp::cli {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "boicp/batch_pair.hpp"
+#include "boicp/mapping/batch_pair.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "boicp/batch_pair.hpp"
+#include "boicp/mapping/batch_pair.hpp"
 #include "commands.hpp"
 #include "remote_json.hpp"
 #include "remote_options.hpp"

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 #include "sha256.hpp"
 #include "storage_errors.hpp"
 

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <string>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp::server {
 namespace {

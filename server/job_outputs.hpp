@@ -4,7 +4,7 @@
 #include <optional>
 #include <string>
 
-#include "boicp/map_assembly.hpp"
+#include "boicp/mapping/map_assembly.hpp"
 #include "boicp/v1/map_builder.pb.h"
 
 namespace boicp::server {

@@ -10,8 +10,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "boicp/batch_pair.hpp"
-#include "boicp/map_assembly.hpp"
+#include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/map_assembly.hpp"
 #include "job_outputs.hpp"
 #include "job_spec.hpp"
 #include "pair_task.hpp"

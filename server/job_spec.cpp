@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "boicp/batch_pair.hpp"
+#include "boicp/mapping/batch_pair.hpp"
 #include "job_limits.hpp"
 #include "proto_convert.hpp"
 

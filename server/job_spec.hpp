@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "boicp/batch_pair.hpp"
-#include "boicp/config.hpp"
-#include "boicp/map_assembly.hpp"
-#include "boicp/map_pairs.hpp"
+#include "boicp/mapping/batch_pair.hpp"
+#include "boicp/registration/config.hpp"
+#include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/map_pairs.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
 

@@ -4,7 +4,7 @@
 #include <cstring>
 #include <set>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 #include "proto_convert.hpp"
 
 namespace boicp::server {

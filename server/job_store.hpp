@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "boicp/pose_graph.hpp"
+#include "boicp/mapping/pose_graph.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "sqlite_db.hpp"
 

@@ -11,7 +11,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
-#include "boicp/openmp_policy.hpp"
+#include "boicp/util/openmp_policy.hpp"
 #include "daemon.hpp"
 #include "daemon_options.hpp"
 
@@ -30,7 +30,7 @@ sigset_t ShutdownSignals() {
 int main(int argc, char** argv) {
   boicp::RestartWithPassiveOpenMpWait(argv);
   CLI::App app{"boicpd: BO-ICP map-building daemon (gRPC)"};
-  app.set_version_flag("--version", "boicpd 0.1.0");
+  app.set_version_flag("--version", "boicpd " BOICP_VERSION);
   boicp::server::DaemonOptions options;
   boicp::server::AddDaemonOptions(app, options);
   try {

@@ -1,6 +1,6 @@
 #include "pair_task.hpp"
 
-#include "boicp/batch_pair.hpp"
+#include "boicp/mapping/batch_pair.hpp"
 #include "proto_convert.hpp"
 
 namespace boicp::server {

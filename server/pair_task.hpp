@@ -3,7 +3,7 @@
 
 #include <functional>
 
-#include "boicp/pose_graph.hpp"
+#include "boicp/mapping/pose_graph.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "job_spec.hpp"
 

@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "boicp/point_cloud_io.hpp"
-#include "boicp/types.hpp"
+#include "boicp/io/point_cloud_io.hpp"
+#include "boicp/util/types.hpp"
 #include "boicp/v1/map_builder.pb.h"
 
 namespace boicp::server {

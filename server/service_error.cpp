@@ -2,7 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {

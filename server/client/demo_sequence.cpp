@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "boicp/synthetic_scene.hpp"
+#include "boicp/io/synthetic_scene.hpp"
 
 namespace boicp::client {
 

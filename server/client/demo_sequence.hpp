@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp::client {
 

@@ -22,10 +22,10 @@
 #include <open3d/io/ImageIO.h>
 #include <nlohmann/json.hpp>
 
-#include "boicp/point_cloud_io.hpp"
-#include "boicp/scan_folder.hpp"
-#include "boicp/synthetic_scene.hpp"
-#include "boicp/trajectory_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
+#include "boicp/io/scan_folder.hpp"
+#include "boicp/io/synthetic_scene.hpp"
+#include "boicp/io/trajectory_io.hpp"
 
 #ifdef BOICP_TEST_WITH_DAEMON
 #include "../support/files_and_processes.hpp"

@@ -16,8 +16,8 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/files_and_processes.hpp"
-#include "boicp/point_cloud_io.hpp"
-#include "boicp/synthetic_scene.hpp"
+#include "boicp/io/point_cloud_io.hpp"
+#include "boicp/io/synthetic_scene.hpp"
 
 #ifndef BOICP_SHARED_DATA_DIR
 #define BOICP_SHARED_DATA_DIR ""

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "boicp/point_cloud_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
 
 namespace boicp::fuzz {
 

@@ -5,7 +5,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "boicp/map_pairs.hpp"
+#include "boicp/mapping/map_pairs.hpp"
 #include "demo_sequence.hpp"
 
 namespace boicp::load {

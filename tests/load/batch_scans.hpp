@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "boicp/synthetic_scene.hpp"
+#include "boicp/io/synthetic_scene.hpp"
 
 namespace boicp::load {
 

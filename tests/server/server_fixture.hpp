@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 #include "daemon_process.hpp"
 #include "map_builder_client.hpp"
 

@@ -3,8 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "boicp/map_pairs.hpp"
-#include "boicp/types.hpp"
+#include "boicp/mapping/map_pairs.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/types.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp::test {
 

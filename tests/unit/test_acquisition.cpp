@@ -1,12 +1,12 @@
-#include "boicp/acquisition.hpp"
+#include "boicp/registration/acquisition.hpp"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "boicp/sampling.hpp"
-#include "boicp/types.hpp"
+#include "boicp/registration/sampling.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp {
 namespace {

@@ -1,4 +1,4 @@
-#include "boicp/bayes_opt.hpp"
+#include "boicp/registration/bayes_opt.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/sampling.hpp"
-#include "boicp/types.hpp"
+#include "boicp/registration/sampling.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp {
 namespace {

@@ -3,8 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "boicp/config.hpp"
-#include "boicp/types.hpp"
+#include "boicp/registration/config.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp {
 namespace {

@@ -10,7 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "boicp/point_cloud_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
 
 namespace boicp {
 namespace {

@@ -1,4 +1,4 @@
-#include "boicp/gaussian_process.hpp"
+#include "boicp/registration/gaussian_process.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/sampling.hpp"
+#include "boicp/registration/sampling.hpp"
 
 namespace boicp {
 namespace {

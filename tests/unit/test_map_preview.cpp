@@ -13,8 +13,8 @@
 #include <Eigen/Geometry>
 
 #include "../support/files_and_processes.hpp"
-#include "boicp/map_preview.hpp"
-#include "boicp/occupancy_map.hpp"
+#include "boicp/mapping/map_preview.hpp"
+#include "boicp/mapping/occupancy_map.hpp"
 
 namespace boicp {
 namespace {

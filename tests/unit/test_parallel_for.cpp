@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "boicp/parallel_for.hpp"
+#include "boicp/util/parallel_for.hpp"
 
 namespace boicp {
 namespace {

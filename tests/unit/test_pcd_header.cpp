@@ -13,7 +13,7 @@
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/io/PointCloudIO.h>
 
-#include "boicp/point_cloud_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
 
 namespace boicp {
 namespace {

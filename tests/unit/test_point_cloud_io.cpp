@@ -22,7 +22,7 @@
 #include <open3d/io/PointCloudIO.h>
 
 #include "../support/input_error.hpp"
-#include "boicp/point_cloud_io.hpp"
+#include "boicp/io/point_cloud_io.hpp"
 
 #ifndef BOICP_SHARED_DATA_DIR
 #define BOICP_SHARED_DATA_DIR ""

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "../support/input_error.hpp"
-#include "boicp/scan_folder.hpp"
+#include "boicp/io/scan_folder.hpp"
 
 #ifndef BOICP_SHARED_DATA_DIR
 #define BOICP_SHARED_DATA_DIR ""

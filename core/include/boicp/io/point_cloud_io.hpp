@@ -1,0 +1,90 @@
+#pragma once
+// Loading point clouds from files: KITTI .bin, PCD, PLY, XYZ text and 16-bit
+// depth PNGs. Every loader drops non-finite points and counts them; every
+// failure throws boicp::InputError with a one-line message naming the file.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+enum class CloudFormat { kAuto, kKittiBin, kPcd, kPly, kXyz, kDepthPng };
+
+/// Parses "auto", "kitti"/"bin", "pcd", "ply", "xyz", "depth"/"png".
+/// Throws InputError for anything else.
+CloudFormat ParseCloudFormat(const std::string& name);
+std::string CloudFormatName(CloudFormat format);
+
+/// Format from the file extension (.bin .pcd .ply .xyz .txt .png, any case).
+/// Throws InputError when the extension is not one of these.
+CloudFormat DetectCloudFormat(const std::string& path);
+
+/// Pinhole intrinsics of a depth camera, in pixels. Pixel centres sit at
+/// integer (u = column, v = row) coordinates.
+struct Intrinsics {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+};
+
+/// Parses "fx,fy,cx,cy". Throws InputError unless four finite numbers with fx, fy > 0.
+Intrinsics ParseIntrinsics(const std::string& text);
+
+/// Reads intrinsics from a file holding either four numbers "fx fy cx cy" or a
+/// 3x3 camera matrix K (as 7-Scenes' camera-intrinsics.txt). Throws InputError.
+Intrinsics ReadIntrinsicsFile(const std::string& path);
+
+/// How to turn a depth PNG into points. There are no default intrinsics or
+/// scale on purpose: TUM uses 5000 per metre, 7-Scenes 1000.
+struct DepthOptions {
+  std::optional<Intrinsics> intrinsics;               // required for depth images
+  double depth_scale = 0.0;                           // raw units per metre; required (> 0)
+  std::vector<uint16_t> invalid_values = {0, 65535};  // raw values that mean "no depth"
+};
+
+/// Points a loader accepts unless told otherwise: about 120 MB of points.
+constexpr uint64_t kDefaultMaxPoints = 5000000;
+
+struct LoadOptions {
+  CloudFormat format = CloudFormat::kAuto;  // kAuto: from the extension
+  DepthOptions depth;
+  /// More points than this (as the header declares them, or as counted for
+  /// text) is refused before the points are allocated.
+  uint64_t max_points = kDefaultMaxPoints;
+};
+
+/// A file that declares more points than LoadOptions::max_points.
+class PointLimitError : public InputError {
+ public:
+  PointLimitError(const std::string& path, uint64_t points, uint64_t limit);
+  uint64_t points() const { return points_; }
+  uint64_t limit() const { return limit_; }
+
+ private:
+  uint64_t points_, limit_;
+};
+
+struct LoadedCloud {
+  Points points;                            // finite points only, in the sensor frame, metres
+  size_t dropped_nonfinite = 0;             // NaN / inf points removed while loading
+  CloudFormat format = CloudFormat::kAuto;  // the format actually used
+};
+
+/// Loads one cloud. Throws PointLimitError over options.max_points, checked
+/// against the header before anything is allocated. Throws InputError when the file is missing or
+/// unreadable, the format is unknown or malformed (truncated .bin, bad PLY header, PNG that is not
+/// 16-bit single channel), depth options are missing, or no finite point is left.
+LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options = {});
+
+/// Reads a rigid transform from a text file holding 12 (3x4, row-major) or 16
+/// (4x4, row-major) numbers. Throws InputError when the file is not that or the
+/// rotation part is not orthonormal (tolerance 1e-3).
+Transform ReadTransformFile(const std::string& path);
+
+/// Writes points as an ASCII XYZ file, one "x y z" line per point.
+void WriteXyz(const std::string& path, const Points& points);
+
+}  // namespace boicp

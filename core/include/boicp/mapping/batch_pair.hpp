@@ -1,0 +1,62 @@
+#pragma once
+// One pair registration of a scan batch, as the daemon's workers and the
+// one-shot `boicp map` command both run it: the pair's own seed, the scans'
+// prior poses, and the information matrix the pose graph weighs it by.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "boicp/registration/auto_settings.hpp"
+#include "boicp/registration/bo_icp.hpp"
+#include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/map_pairs.hpp"
+#include "boicp/mapping/pose_graph.hpp"
+
+namespace boicp {
+
+struct BatchPairResult {
+  RegistrationResult registration;  // transform = T_target_source
+  InformationMatrix information;    // from correspondences at the refine voxel
+  uint64_t seed = 0;                // the pair's seed, PairSeed(job seed, pair)
+};
+
+/// Loads scans[pair.source] and scans[pair.target] and runs BO-ICP with
+/// `job_config` but seed PairSeed(job_config.seed, pair), centred on
+/// PairPrior when both scans have a prior pose. Throws Cancelled when
+/// `stop_requested` fires, InputError when a scan does not load (or an
+/// index is out of range), std::runtime_error for engine failures.
+BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                                  const BoIcpConfig& job_config,
+                                  const std::function<bool()>& stop_requested = {});
+
+/// Which map settings a batch leaves to be chosen from its scans.
+struct MapAutoFields {
+  bool resolution = true;  // OccupancySettings::resolution, reported as "map_resolution"
+  bool max_range = true;   // OccupancySettings::max_range, reported as "map_max_range"
+};
+
+/// Chooses, once for the whole batch, the fields of `config` still in
+/// config.automatic and the map fields `map_auto` names, from up to 5 of the
+/// scans spread evenly over the batch (so every pair, every shard and every
+/// resume gets the same settings). Returns the names of the fields it set;
+/// loads nothing when nothing is automatic. Throws InputError when a scan
+/// does not load or is too small to choose settings from.
+std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans,
+                                            BoIcpConfig& config, OccupancySettings& occupancy,
+                                            const MapAutoFields& map_auto);
+
+/// The keyframe overlap threshold of a batch: that of its first non-depth
+/// scan's format (0.7), or 0.6 when every scan is a depth image.
+double BatchOverlapThreshold(const std::vector<ScanSource>& scans);
+
+/// The closing line of a batch: "2 of 40 pairs doubtful" (doubtful =
+/// confidence below kDoubtfulBelow).
+std::string DoubtfulSummary(int doubtful, int total);
+
+/// Pose-graph options matching how RegisterBatchPair computed the
+/// information matrices (correspondences within the inlier distance).
+PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config);
+
+}  // namespace boicp

@@ -1,0 +1,90 @@
+#pragma once
+// Map assembly, shared by the daemon and the one-shot map command: from the
+// registered pairs of a batch to poses (chained, then optimised when loops
+// close), then to an OctoMap, a merged cloud and trajectory files.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/mapping/occupancy_map.hpp"
+#include "boicp/io/point_cloud_io.hpp"
+#include "boicp/mapping/pose_graph.hpp"
+
+namespace boicp {
+
+/// One scan of a batch as assembly needs it.
+struct ScanSource {
+  std::string path;  // file to load
+  LoadOptions load;  // format (explicit, or from the extension) and depth options
+  Point sensor_origin = Point::Zero();  // ray origin in the scan frame, metres
+  std::optional<Transform> prior_pose;  // odometry T_world_scan, when known
+  std::optional<double> timestamp;      // seconds, when known
+};
+
+/// Prior for registering `source` onto `target` from their prior poses:
+/// T_target_source = T_world_target^-1 * T_world_source; nullopt unless both have one.
+std::optional<Transform> PairPrior(const ScanSource& source, const ScanSource& target);
+
+/// Each scan's timestamp, or its index where it has none.
+std::vector<double> ScanTimestamps(const std::vector<ScanSource>& scans);
+
+struct PoseEstimate {
+  std::vector<Transform> poses;  // T_map_scan
+  bool optimised = false;        // a pose graph was optimised (loops closed)
+  int loop_closures = 0;
+  /// Per constraint: used by the final poses (false for loop closures the
+  /// optimisation pruned or, being doubtful, left out).
+  std::vector<bool> kept;
+};
+
+/// Chains the constraints (listed with the sequential chain first; trusted
+/// ones before doubtful ones, see ChainPoses) into poses and, when some
+/// close loops, optimises the pose graph with each edge weighted by its
+/// confidence (OptimizePoseGraph). The map frame is scan 0's prior world
+/// frame when scan 0 has a prior pose, else scan 0's own frame. Throws
+/// InputError when the constraints leave a scan unreached.
+PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
+                           const std::vector<PairConstraint>& constraints,
+                           const PoseGraphOptions& options);
+
+struct MapBuildSettings {
+  OccupancySettings occupancy;
+  double cloud_voxel = 0.0;  // metres, merged-cloud voxel; 0 = occupancy.resolution
+};
+
+/// Where to write each output; an empty path skips that output. Every file
+/// is written to a staging file beside it and renamed (WriteFileAtomically), so
+/// a reader never sees half a file.
+struct MapOutputPaths {
+  std::string octomap_bt, octomap_ot, trajectory_tum, trajectory_kitti, cloud_ply;
+};
+
+struct AssemblyProgress {
+  std::string stage;  // "fusing" or "writing"
+  int done = 0;
+  int total = 0;
+};
+
+struct AssemblyCallbacks {
+  std::function<void(const AssemblyProgress&)> progress;
+  std::function<bool()> stop_requested;  // polled between scans; true -> boicp::Cancelled
+};
+
+struct FusionSummary {
+  size_t occupied_leaves = 0;
+  size_t cloud_points = 0;
+  double seconds = 0.0;
+};
+
+/// Loads every scan, inserts it into the OctoMap at its pose with its sensor
+/// origin, accumulates the merged cloud (points within max_range only), and
+/// writes the requested outputs. Throws InputError for invalid settings or a
+/// scan that no longer loads, Cancelled when stop_requested fires, and
+/// std::runtime_error when an output cannot be written.
+FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
+                        const MapBuildSettings& settings, const MapOutputPaths& outputs,
+                        const AssemblyCallbacks& callbacks = {});
+
+}  // namespace boicp

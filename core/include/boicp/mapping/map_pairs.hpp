@@ -1,0 +1,96 @@
+#pragma once
+// Which pairs of a scan batch get registered: consecutive scans, keyframes
+// chosen by overlap (as in the BO-ICP paper), or an explicit list (how loop
+// closures come in), and the seed each pair's search uses.
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "boicp/io/point_cloud_io.hpp"
+
+namespace boicp {
+
+/// One registration of a batch, by index into the batch's scan list. The
+/// registration estimates T_target_source.
+struct PairIndex {
+  int source = 0;
+  int target = 0;
+  bool operator==(const PairIndex& other) const {
+    return source == other.source && target == other.target;
+  }
+  bool operator<(const PairIndex& other) const {
+    return source != other.source ? source < other.source : target < other.target;
+  }
+};
+
+/// Scan i (source) onto scan i+1 (target) for every i < num_scans - 1, the
+/// direction of the shared data's pairs.csv.
+std::vector<PairIndex> ConsecutivePairs(int num_scans);
+
+/// Throws InputError naming the first bad pair: an index outside
+/// [0, num_scans), a scan paired with itself, or a pair given twice (in
+/// either direction). With `require_connected`, also throws unless the pairs
+/// connect every scan, naming a scan that no chain of pairs reaches from scan 0.
+void ValidatePairs(int num_scans, const std::vector<PairIndex>& pairs, bool require_connected);
+
+/// The search seed of one pair: a SplitMix64 mix of the job seed and the two
+/// indices. It depends on nothing else, so a batch that is resumed or
+/// scheduled differently gives every pair the same result.
+uint64_t PairSeed(uint64_t job_seed, const PairIndex& pair);
+
+/// The paper's overlap thresholds for keyframes: 0.6 for depth images, 0.7
+/// for LiDAR and every other point format.
+double DefaultOverlapThreshold(CloudFormat format);
+
+/// Keyframe selection by overlap. Every scan j after the current keyframe k
+/// is registered onto it (pair source = j, target = k) and its overlap is
+/// the registration's overlap estimate (RegistrationResult::overlap: the
+/// fraction of j within 1.5 search voxels of k; raw fitness counts only
+/// points within the tight inlier distance, so sensor noise and a loose fine
+/// alignment lower it without less being seen). While the overlap stays at
+/// or above the threshold the scan hangs off k. When scan j falls below it,
+/// scan j-1 becomes the next keyframe and j is registered onto that one
+/// instead (the probe j -> k is dropped). A scan adjacent to its keyframe is always kept,
+/// however small its overlap, so the chain never breaks.
+///
+/// Decisions depend only on the overlap values recorded, never on the order
+/// they arrive in, so a resumed batch makes the same choices. Probes can run
+/// ahead (NextProbes); those beyond a keyframe change are wasted but harmless.
+class KeyframePlanner {
+ public:
+  /// Preconditions: num_scans >= 1, overlap_threshold in (0, 1].
+  KeyframePlanner(int num_scans, double overlap_threshold);
+
+  /// Up to `max_count` probes not handed out before, all onto the current
+  /// keyframe, in scan order. Empty when the plan needs results first or is done.
+  std::vector<PairIndex> NextProbes(int max_count);
+
+  /// Records a finished probe's overlap estimate (in [0, 1]; results stored
+  /// before overlap was computed pass their fitness) and advances the plan
+  /// as far as the recorded results allow. Results for pairs the plan no
+  /// longer needs are kept but change nothing.
+  void Record(const PairIndex& pair, double overlap);
+
+  /// True once every scan hangs off a keyframe.
+  bool Done() const { return next_ >= num_scans_; }
+
+  /// The pairs that form the chain so far (one per scan after the first).
+  const std::vector<PairIndex>& ChainPairs() const { return chain_; }
+
+  /// Scans attached so far (scan 0 counts as attached).
+  int AttachedScans() const { return next_; }
+
+ private:
+  void Advance();
+
+  int num_scans_;
+  double threshold_;
+  int keyframe_ = 0;
+  int next_ = 1;        // first scan not yet attached
+  int next_probe_ = 1;  // first scan not yet handed out as a probe onto keyframe_
+  std::map<PairIndex, double> overlap_;
+  std::vector<PairIndex> chain_;
+};
+
+}  // namespace boicp

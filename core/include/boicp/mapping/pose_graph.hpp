@@ -1,0 +1,99 @@
+#pragma once
+// From pairwise registrations to scan poses: chaining along a spanning tree,
+// and pose-graph optimisation (Open3D's Levenberg-Marquardt with line
+// processes) when extra pairs close loops.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "boicp/registration/bo_icp.hpp"
+#include "boicp/mapping/map_pairs.hpp"
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+using InformationMatrix = Eigen::Matrix<double, 6, 6>;
+
+/// One registered pair as a pose-graph edge.
+struct PairConstraint {
+  PairIndex pair;
+  Transform T_target_source = Transform::Identity();
+  /// Weight of the edge in the optimisation; Open3D's convention (rotation
+  /// first, then translation), as PairInformation computes it.
+  InformationMatrix information = InformationMatrix::Identity();
+  /// The pair's estimated probability of being right, in [0, 1]
+  /// (RegistrationResult::confidence); 1 = fully trusted.
+  double confidence = 1.0;
+};
+
+/// True when the constraint's confidence is below kDoubtfulBelow.
+bool IsDoubtfulEdge(const PairConstraint& constraint);
+
+/// Poses T_map_scan from chaining, and which constraints the chain used.
+struct ChainedPoses {
+  std::vector<Transform> poses;
+  /// Per constraint: true if it is an edge of the spanning tree. The others
+  /// close loops (and make a pose-graph optimisation worthwhile).
+  std::vector<bool> in_tree;
+  int loop_closures = 0;
+};
+
+/// Chains the constraints into poses with T_map_scan0 = `anchor`: a spanning
+/// tree is grown from the trusted constraints in the order given (so a
+/// sequential chain listed first is preferred over loop closures), then
+/// from the doubtful ones, so a doubtful pair is chained only where no
+/// trusted one connects the same parts. Each pose follows T_map_source =
+/// T_map_target * T_target_source along the tree. Throws InputError when a
+/// scan is not reached.
+ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constraints,
+                        const Transform& anchor = Transform::Identity());
+
+struct PoseGraphOptions {
+  /// Metres; the distance the edges' information matrices were computed
+  /// with. Open3D derives the line-process weight of loop closures from it.
+  double max_correspondence_distance = 0.5;
+  double edge_prune_threshold = 0.25;    // loop closures weighted below this are dropped
+  double preference_loop_closure = 1.0;  // Open3D: <1 trusts the tree more, >1 the loops
+  int max_iterations = 100;
+  /// A doubtful loop closure joins the optimisation only when the initial
+  /// poses agree with it: its starting line-process weight under them,
+  /// (mu / (mu + r^2))^2 at full information (1 = exact agreement), must be
+  /// at least this.
+  double doubtful_keep_threshold = 0.5;
+};
+
+/// The smallest factor a tree edge's information is scaled by, so the
+/// optimisation stays well posed when a pair's confidence is 0.
+constexpr double kMinEdgeWeight = 1e-3;
+
+struct OptimizedPoses {
+  std::vector<Transform> poses;  // T_map_scan, scan 0 unchanged
+  std::vector<bool> kept;        // per constraint: false if pruned as an outlier loop closure
+  /// Per constraint: Open3D's final line-process weight in [0, 1] (1 for
+  /// tree edges, 0 for pruned or left-out loop closures).
+  std::vector<double> line_process;
+};
+
+/// Optimises the poses over all constraints, each edge's information
+/// scaled by its confidence (at least kMinEdgeWeight), so a doubtful edge
+/// gives way to the trusted ones around it. Tree edges (in_tree) are
+/// certain; the others are loop closures that Open3D's line process may
+/// down-weight and prune, starting from their confidence. A doubtful loop
+/// closure the initial poses disagree with (doubtful_keep_threshold) is left
+/// out. With every confidence 1 this is Open3D's optimisation unchanged.
+/// Preconditions: `initial` has one pose per scan and in_tree one flag per
+/// constraint; a constraint naming a scan outside `initial` throws InputError.
+OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
+                                 const std::vector<PairConstraint>& constraints,
+                                 const std::vector<bool>& in_tree, const PoseGraphOptions& options);
+
+/// Information matrix of a registered pair from its point correspondences
+/// within `max_distance` metres under T_target_source (Open3D's
+/// GetInformationMatrixFromPointClouds). Both clouds are in their sensor
+/// frames, metres; pass downsampled clouds, the cost is one kd-tree search
+/// per source point.
+InformationMatrix PairInformation(const Points& source, const Points& target,
+                                  const Transform& T_target_source, double max_distance);
+
+}  // namespace boicp

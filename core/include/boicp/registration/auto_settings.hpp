@@ -1,0 +1,71 @@
+#pragma once
+// Settings chosen from the clouds themselves, so that a folder of scans needs
+// no per-dataset flags: the search scale, the search box and the map's
+// resolution follow the scene's size, and the rotation box follows the
+// sensor (a level LiDAR only turns about z; anything else may turn anyhow).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/registration/config.hpp"
+#include "boicp/io/point_cloud_io.hpp"
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+enum class SensorKind { kLidar, kDepthCamera, kOther };
+std::string SensorKindName(SensorKind kind);  // "lidar" | "depth camera" | "other"
+
+/// What the settings are chosen from, measured on one cloud in its sensor frame.
+struct CloudStatistics {
+  size_t points = 0;
+  double rms_radius = 0.0;  // RMS distance from the centroid, metres
+  double range_p95 = 0.0;   // 95th percentile of the distance from the sensor origin, metres
+  double spacing = 0.0;     // median distance from a point to its nearest other point, metres
+  bool all_around = false;  // points on every side of the origin (a spinning LiDAR)
+  /// Angle (radians) between +z and the normal of a ground plane below the
+  /// origin that holds a large share of the points; nullopt when none is found.
+  std::optional<double> ground_tilt;
+};
+
+/// Measures `cloud` (metres, sensor frame). Random choices use `seed`.
+/// Throws InputError when the cloud has fewer than kMinPointsForSettings
+/// points or no extent, with a message that names the flags to give instead.
+CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed);
+
+constexpr size_t kMinPointsForSettings = 100;
+
+/// Every setting automatic mode chooses, with the sensor it assumed.
+struct ChosenSettings {
+  SensorKind sensor = SensorKind::kOther;
+  double voxel = 0.0;          // metres, search voxel for preset C (truncation follows it)
+  double point_spacing = 0.0;  // metres; with the voxel, sets the refinement voxel
+  Eigen::Vector3d translation_bounds = Eigen::Vector3d::Zero();  // metres
+  Eigen::Vector3d rotation_bounds = Eigen::Vector3d::Zero();     // radians
+  double map_resolution = 0.0;                                   // metres
+  double map_max_range = 0.0;                                    // metres
+};
+
+/// The settings for clouds measured by `stats` (at least one), read in
+/// `format` (kAuto when unknown: the sensor then comes from the geometry).
+ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format);
+
+/// Measures up to `max_clouds` of `clouds`, evenly spread (a batch's settings
+/// come from a few scans, so that every pair of it shares them), and chooses.
+ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds, CloudFormat format,
+                                       uint64_t seed, size_t max_clouds = 5);
+
+/// Copies the chosen values into the fields of `config` still listed in
+/// config.automatic (the voxel scaled as the preset's is against C's) and
+/// clears that list. Returns the names of the fields it set, in
+/// kAutoRegistrationFields order.
+std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcpConfig& config);
+
+/// One line for the user: preset, search mode, sensor, and the voxel,
+/// refinement voxel and boxes, each marked "(auto)" when in `auto_fields`.
+std::string DescribeSettings(const BoIcpConfig& config, const std::vector<std::string>& auto_fields,
+                             SensorKind sensor);
+
+}  // namespace boicp

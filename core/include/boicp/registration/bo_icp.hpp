@@ -1,0 +1,102 @@
+#pragma once
+// BO-ICP: Bayesian optimisation over ICP's initial transform (Biggie,
+// Beathard, Heckman), nested (rotation, then translation) or in 6 DOF,
+// followed by a fine ICP refinement.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "boicp/registration/confidence.hpp"
+#include "boicp/registration/config.hpp"
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+/// One ICP run started by the search. A run that reached the end of an
+/// earlier converged run (BoIcpConfig::join_converged_runs) reports that end
+/// and its objective.
+struct Evaluation {
+  int stage = 0;                              // 0 = rotation / joint, 1 = translation
+  Transform initial = Transform::Identity();  // T0 that BO proposed
+  Transform result = Transform::Identity();   // where ICP took it
+  double objective = 0.0;                     // truncated mean distance after ICP, metres
+};
+
+/// One search of a registration: the first, and the retry of a doubtful one.
+struct Attempt {
+  SearchMode mode = SearchMode::kNested;
+  uint64_t seed = 0;
+  double fitness = 0.0;  // inlier fraction of its refined answer at the finest level
+  double confidence = 0.0;
+  int evaluations = 0;
+  double runtime_s = 0.0;
+  bool kept = false;  // its answer is the result's
+};
+
+/// A result whose confidence is below this is reported as doubtful.
+constexpr double kDoubtfulBelow = 0.5;
+
+/// Result of registering one pair. Frame convention: `transform` is
+/// T_target_source, so p_target = transform * p_source (metres, radians).
+struct RegistrationResult {
+  Transform transform = Transform::Identity();
+  double objective = 0.0;    // best search objective (truncated mean NN distance, metres)
+  double fitness = 0.0;      // fraction of refined source points within inlier_distance
+  double inlier_rmse = 0.0;  // RMS distance of those points, metres
+  /// Fraction of the search-voxel source within 1.5 search voxels of the
+  /// target: how much of the source the target sees, for keyframe choice.
+  double overlap = 0.0;
+  /// Estimated probability, in [0,1], that `transform` is within the success
+  /// thresholds (2 degrees, and a few refinement voxels).
+  double confidence = 0.0;
+  bool doubtful = false;            // confidence < kDoubtfulBelow
+  ConfidenceFeatures features;      // what confidence was computed from
+  double gp_mean = 0.0;             // GP posterior mean at the optimum (last stage), metres
+  double gp_std = 0.0;              // GP posterior standard deviation there, metres
+  double probability_better = 0.0;  // max over stages of the GP's P(some other point is better)
+  int evaluations = 0;              // ICP runs made by the kept search
+  double runtime_s = 0.0;           // wall time of RegisterPair, retries included
+  size_t source_points = 0;         // after search downsampling
+  size_t target_points = 0;
+  std::vector<Evaluation> history;  // of the kept search
+  std::vector<Attempt> attempts;    // every search made, first first
+  /// The settings used, automatic fields resolved, and the names of those
+  /// chosen from the clouds.
+  BoIcpConfig config;
+  std::vector<std::string> auto_fields;
+};
+
+struct RegistrationProgress {
+  std::string stage;  // "rotation", "translation", "6dof" or "refine"
+  int done = 0;       // evaluations finished in this stage
+  int total = 0;      // evaluations planned in this stage
+  double best_objective = 0.0;
+};
+
+struct RegistrationCallbacks {
+  std::function<void(const RegistrationProgress&)> progress;
+  std::function<bool()> stop_requested;  // polled between rounds; true -> boicp::Cancelled
+  /// Replaces the ICP run inside each search evaluation, for baselines that
+  /// measure another ICP implementation against the same search (called from
+  /// config.threads threads at once, so it must be thread-safe): aligns
+  /// `source` onto `target` from `initial` and returns T_target_source. Empty:
+  /// core's point-to-point ICP against the prebuilt target index.
+  std::function<Transform(const Points& source, const Points& target, const Transform& initial)>
+      local_icp;
+};
+
+/// Registers `source` onto `target` (raw clouds in their sensor frames).
+/// Fields still in config.automatic are first chosen from the two clouds
+/// (auto_settings.hpp). `prior`, when given (for example odometry), centres
+/// the search box and is the first sample. A doubtful answer is searched for
+/// once more when config.retry_when_doubtful. Throws InputError for an
+/// invalid config, a cloud too small to choose settings from or left empty by
+/// cropping/downsampling, and Cancelled when stop_requested fires.
+RegistrationResult RegisterPair(const Points& source, const Points& target,
+                                const BoIcpConfig& config,
+                                const std::optional<Transform>& prior = std::nullopt,
+                                const RegistrationCallbacks& callbacks = {});
+
+}  // namespace boicp

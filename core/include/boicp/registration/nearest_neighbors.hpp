@@ -1,0 +1,42 @@
+#pragma once
+// A kd-tree over a fixed target cloud, built once and queried many times:
+// BO-ICP evaluates hundreds of ICP runs against one target, so the tree must
+// outlive any single run (Open3D's RegistrationICP rebuilds it per call).
+
+#include <memory>
+
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+class NearestNeighborIndex {
+ public:
+  /// Builds the tree over a copy of `points`. Precondition: points non-empty.
+  explicit NearestNeighborIndex(Points points);
+  ~NearestNeighborIndex();
+  NearestNeighborIndex(NearestNeighborIndex&&) noexcept;
+  NearestNeighborIndex& operator=(NearestNeighborIndex&&) noexcept;
+
+  /// Nearest target point to `query` within sqrt(max_squared_distance) metres.
+  /// Returns false when there is none; otherwise sets index and squared distance.
+  /// Thread-safe for concurrent queries; allocates nothing.
+  bool Nearest(const Point& query, double max_squared_distance, size_t& index,
+               double& squared_distance) const;
+
+  /// The same, given a target point `hint` (an index into points()) known to
+  /// be close, such as the previous ICP iteration's match: its distance
+  /// bounds the search from the start, so far fewer tree cells are visited.
+  /// Same answer as Nearest except that among points at exactly the hint's
+  /// distance the hint is returned. Precondition: hint < size().
+  bool NearestWithHint(const Point& query, size_t hint, double max_squared_distance, size_t& index,
+                       double& squared_distance) const;
+
+  const Points& points() const;
+  size_t size() const { return points().size(); }
+
+ private:
+  struct Tree;
+  std::unique_ptr<Tree> tree_;
+};
+
+}  // namespace boicp

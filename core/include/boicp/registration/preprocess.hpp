@@ -1,0 +1,26 @@
+#pragma once
+// Preprocessing steps applied to a cloud before registration.
+
+#include <cstdint>
+
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+/// Keeps points whose distance from the sensor origin lies in [min_range,
+/// max_range] metres. max_range <= 0 means no upper limit.
+Points CropByRange(const Points& points, double min_range, double max_range);
+
+/// Replaces the points in each cubic voxel of edge `voxel` metres by their
+/// centroid (Open3D's VoxelDownSample). voxel <= 0 returns the input unchanged.
+Points VoxelDownsample(const Points& points, double voxel);
+
+/// At most `max_points` points chosen uniformly without replacement, in their
+/// original order; reproducible for a given seed. max_points == 0 or
+/// max_points >= size returns the input unchanged.
+Points RandomSubsample(const Points& points, size_t max_points, uint64_t seed);
+
+/// Mean of the points (zero for an empty input).
+Point Centroid(const Points& points);
+
+}  // namespace boicp

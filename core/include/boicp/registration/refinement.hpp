@@ -1,0 +1,74 @@
+#pragma once
+// The stages around the search that every initialiser shares: cropping and
+// downsampling once per pair, and the coarse-to-fine ICP that turns a coarse
+// initial transform into the final answer. BO-ICP uses them, and so does
+// every baseline the bench compares it with, so that methods differ only in
+// how they find the initial transform.
+
+#include <vector>
+
+#include "boicp/registration/alignment_score.hpp"
+#include "boicp/registration/config.hpp"
+#include "boicp/registration/icp.hpp"
+#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+/// Crops `raw` to [config.min_range, config.max_range] and voxel-downsamples it
+/// at `voxel` metres. Throws InputError naming `which` ("source" or "target")
+/// when fewer than 3 points are left.
+Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which);
+
+/// ICP settings of one search evaluation: the config's correspondence gate and
+/// iteration cap, converging once a step moves less than 1e-2 voxel and turns
+/// less than 1e-3 rad.
+IcpOptions SearchIcpOptions(const BoIcpConfig& config);
+
+/// One level of the refinement pyramid.
+struct PyramidLevel {
+  double voxel = 0.0;           // metres
+  Points source;                // at most config.refine_source_points of them (random, seeded)
+  NearestNeighborIndex target;  // every point at this voxel
+};
+
+/// Both clouds of a pair at the search voxel and at every refinement level,
+/// built once per pair.
+struct PreparedPair {
+  Points search_source;
+  NearestNeighborIndex search_target;
+  /// Voxels halving from config.voxel / 2 down to the refinement voxel, so
+  /// every level starts inside the next level's basin; finest last.
+  std::vector<PyramidLevel> pyramid;
+};
+
+/// Throws InputError when a cloud is left with fewer than 3 points at any level.
+PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config);
+
+/// A refined transform (T_target_source) and how well it fits at the finest
+/// level, scored with the config's inlier distance.
+struct RefinedAlignment {
+  Transform transform = Transform::Identity();
+  AlignmentScore score;
+  /// 1 - (runner-up's fitness / the answer's fitness) at the finest level, in
+  /// [0, 1]: 0 when another basin fits as well, 1 when none reached that level.
+  double margin = 1.0;
+};
+
+/// Coarse-to-fine point-to-point ICP from each of `starts` (T_target_source,
+/// best guess first; at least one): the search clouds with a 1.5 voxel gate,
+/// then each pyramid level with a gate of 3 of its voxels. At every level the
+/// leader (the best truncated mean so far, clipped at 1.5 voxels of the level)
+/// runs first, and the others are abandoned only once they head for a clearly
+/// worse fit (kClearlyWorse times the leader's), so a wrong basin costs a few
+/// coarse iterations while a near tie reaches the finest level. Runs that meet
+/// (within one voxel of the level and 1 degree) continue as one. Of the basins
+/// that reach the finest level, the one with the largest inlier fraction
+/// wins: the coarse scores of a low-overlap pair's true basin and of a wrong
+/// one can differ by less than their noise, while the fine fit tells them apart.
+constexpr double kClearlyWorse = 1.3;
+
+RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const PreparedPair& pair,
+                                    const BoIcpConfig& config);
+
+}  // namespace boicp

@@ -1,0 +1,43 @@
+#pragma once
+// The box that BO searches, and how a point of it becomes an initial transform.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+/// Rotation R = Rz(yaw) Ry(pitch) Rx(roll), radians.
+Eigen::Matrix3d RotationFromEuler(double roll, double pitch, double yaw);
+
+/// Indices into the six search parameters (roll, pitch, yaw, x, y, z).
+enum SearchParameter { kRoll = 0, kPitch, kYaw, kX, kY, kZ };
+
+/// Maps the unit box [0,1]^d onto initial transforms around an anchor:
+///   T0(u) = Trans(pivot + delta) * R(roll, pitch, yaw) * Trans(-pivot) * anchor,
+/// where each searched parameter is (2 u_k - 1) * half_width and the others
+/// are zero. u = 0.5 everywhere gives the anchor itself. Rotating about the
+/// pivot (the anchor-mapped source centroid) instead of the sensor origin keeps
+/// a rotated depth view over the same part of the scene.
+struct SearchSpace {
+  Transform anchor = Transform::Identity();
+  Point pivot = Point::Zero();              // in the target frame
+  std::vector<SearchParameter> parameters;  // what each unit coordinate controls
+  Eigen::Matrix<double, 6, 1> half_widths = Eigen::Matrix<double, 6, 1>::Zero();
+
+  int dimension() const { return static_cast<int>(parameters.size()); }
+  Transform ToTransform(const Eigen::VectorXd& u) const;
+
+  /// Roll and yaw wrap around when their half-width reaches pi.
+  std::vector<bool> Periodic() const;
+};
+
+/// The rotation-stage, translation-stage or joint box with non-zero
+/// half-widths only (parameters whose half-width is zero are not searched).
+SearchSpace MakeSearchSpace(const Transform& anchor, const Point& pivot,
+                            const Eigen::Vector3d& rotation_half_widths,
+                            const Eigen::Vector3d& translation_half_widths);
+
+}  // namespace boicp

@@ -1,0 +1,139 @@
+// Plain-text files: XYZ point lists and rigid transforms.
+
+#include <charconv>
+#include <cmath>
+
+#include "io/io_readers.hpp"
+
+namespace boicp {
+
+namespace io_detail {
+
+namespace {
+
+constexpr double kOrthonormalTolerance = 1e-3;
+constexpr double kBottomRowTolerance = 1e-9;
+constexpr size_t kQuotedLineLimit = 60;
+
+// Keeps error messages one short line even for binary junk read as text.
+std::string Quoted(const std::string& line) {
+  if (line.size() <= kQuotedLineLimit) return "'" + line + "'";
+  return "'" + line.substr(0, kQuotedLineLimit) + "...'";
+}
+
+// Reads x y z from the first three fields; later columns (intensity, colour,
+// labels) may hold anything and are ignored.
+Point ParseXyzLine(const std::string& line, const std::string& location) {
+  const std::vector<std::string_view> fields = SplitFields(line);
+  Point point;
+  for (size_t i = 0; i < 3; ++i) {
+    const std::optional<double> value = i < fields.size() ? ParseNumber(fields[i]) : std::nullopt;
+    if (!value) {
+      throw InputError(location + ": expected at least 3 numbers (x y z), got " + Quoted(line));
+    }
+    point[static_cast<Eigen::Index>(i)] = *value;
+  }
+  return point;
+}
+
+Transform TransformFromNumbers(const std::string& path, const std::vector<double>& numbers) {
+  if (numbers.size() != 12 && numbers.size() != 16) {
+    throw InputError(path + ": expected 12 (3x4) or 16 (4x4) numbers for a transform, got " +
+                     std::to_string(numbers.size()));
+  }
+  for (double value : numbers) {
+    if (!std::isfinite(value)) throw InputError(path + ": transform holds a non-finite number");
+  }
+  Transform T = Transform::Identity();
+  const size_t rows = numbers.size() / 4;
+  for (size_t r = 0; r < rows; ++r) {
+    for (size_t c = 0; c < 4; ++c) {
+      T(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = numbers[r * 4 + c];
+    }
+  }
+  return T;
+}
+
+void RequireRigid(const std::string& path, const Transform& T) {
+  const Eigen::Vector4d bottom = T.row(3).transpose();
+  if ((bottom - Eigen::Vector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > kBottomRowTolerance) {
+    throw InputError(path + ": last row of a 4x4 transform must be 0 0 0 1");
+  }
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (error > kOrthonormalTolerance) {
+    throw InputError(path + ": rotation part is not orthonormal (max |R^T R - I| = " +
+                     std::to_string(error) + ", tolerance 1e-3)");
+  }
+  // An orthonormal matrix with determinant -1 is a reflection, not a motion.
+  if (R.determinant() < 0.0) {
+    throw InputError(path + ": rotation part is a reflection (determinant -1)");
+  }
+}
+
+// Shortest text that reads back as exactly the same double.
+void AppendNumber(double value, std::string* out) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out->append(buffer, result.ptr);
+}
+
+// Lines holding data (not blank, not '#'), read one at a time.
+uint64_t CountDataLines(const std::string& path) {
+  std::ifstream in = OpenOrThrow(path);
+  uint64_t count = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    count += IsBlankOrComment(line) ? 0 : 1;
+  }
+  if (in.bad()) throw InputError(path + ": read error");
+  return count;
+}
+
+}  // namespace
+
+Points ReadXyzText(const std::string& path, uint64_t max_points) {
+  // Text declares no count: the lines are counted before any point is kept.
+  const uint64_t count = CountDataLines(path);
+  RequirePointCount(path, count, max_points);
+  std::ifstream in = OpenOrThrow(path);
+  Points points;
+  points.reserve(static_cast<size_t>(count));
+  std::string line;
+  for (size_t line_number = 1; std::getline(in, line); ++line_number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (IsBlankOrComment(line)) continue;
+    points.push_back(ParseXyzLine(line, path + ":" + std::to_string(line_number)));
+  }
+  if (in.bad()) throw InputError(path + ": read error");
+  return points;
+}
+
+}  // namespace io_detail
+
+Transform ReadTransformFile(const std::string& path) {
+  const Transform T = io_detail::TransformFromNumbers(path, io_detail::ReadNumbersFile(path));
+  io_detail::RequireRigid(path, T);
+  return T;
+}
+
+void WriteXyz(const std::string& path, const Points& points) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path + ": cannot open for writing");
+  std::string line;
+  for (const Point& p : points) {
+    line.clear();
+    io_detail::AppendNumber(p.x(), &line);
+    line += ' ';
+    io_detail::AppendNumber(p.y(), &line);
+    line += ' ';
+    io_detail::AppendNumber(p.z(), &line);
+    line += '\n';
+    out << line;
+  }
+  out.close();
+  if (!out) throw InputError(path + ": write error");
+}
+
+}  // namespace boicp

@@ -1,0 +1,97 @@
+#include "boicp/mapping/batch_pair.hpp"
+
+#include <algorithm>
+
+#include "boicp/registration/voxel_cloud.hpp"
+
+namespace boicp {
+namespace {
+
+Points Downsample(const Points& points, double voxel) {
+  VoxelAccumulator grid(voxel);
+  grid.Add(points);
+  return grid.Centroids();
+}
+
+const ScanSource& ScanAt(const std::vector<ScanSource>& scans, int index) {
+  if (index < 0 || index >= static_cast<int>(scans.size())) {
+    throw InputError("pair index " + std::to_string(index) + " is outside the batch of " +
+                     std::to_string(scans.size()) + " scans");
+  }
+  return scans[static_cast<size_t>(index)];
+}
+
+}  // namespace
+
+BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                                  const BoIcpConfig& job_config,
+                                  const std::function<bool()>& stop_requested) {
+  const ScanSource& source = ScanAt(scans, pair.source);
+  const ScanSource& target = ScanAt(scans, pair.target);
+  const Points source_points = LoadPointCloud(source.path, source.load).points;
+  const Points target_points = LoadPointCloud(target.path, target.load).points;
+
+  BoIcpConfig config = job_config;
+  config.seed = PairSeed(job_config.seed, pair);
+  RegistrationCallbacks callbacks;
+  callbacks.stop_requested = stop_requested;
+  BatchPairResult out;
+  out.seed = config.seed;
+  out.registration =
+      RegisterPair(source_points, target_points, config, PairPrior(source, target), callbacks);
+  const double voxel = config.EffectiveRefineVoxel();
+  out.information =
+      PairInformation(Downsample(source_points, voxel), Downsample(target_points, voxel),
+                      out.registration.transform, config.EffectiveInlierDistance());
+  return out;
+}
+
+std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans,
+                                            BoIcpConfig& config, OccupancySettings& occupancy,
+                                            const MapAutoFields& map_auto) {
+  if (scans.empty()) throw InputError("a batch needs at least one scan");
+  if (config.automatic.empty() && !map_auto.resolution && !map_auto.max_range) return {};
+  constexpr size_t kSampledScans = 5;
+  const size_t count = std::min(kSampledScans, scans.size());
+  std::vector<Points> clouds;
+  CloudFormat format = CloudFormat::kAuto;
+  for (size_t k = 0; k < count; ++k) {
+    const size_t index = count == 1 ? 0 : k * (scans.size() - 1) / (count - 1);
+    LoadedCloud loaded = LoadPointCloud(scans[index].path, scans[index].load);
+    format = loaded.format;
+    clouds.push_back(std::move(loaded.points));
+  }
+  std::vector<const Points*> pointers;
+  for (const Points& cloud : clouds) pointers.push_back(&cloud);
+  const ChosenSettings chosen = ChooseSettingsForClouds(pointers, format, config.seed, count);
+  std::vector<std::string> set = ApplyChosenSettings(chosen, config);
+  if (map_auto.resolution) {
+    occupancy.resolution = chosen.map_resolution;
+    set.push_back("map_resolution");
+  }
+  if (map_auto.max_range) {
+    occupancy.max_range = chosen.map_max_range;
+    set.push_back("map_max_range");
+  }
+  return set;
+}
+
+double BatchOverlapThreshold(const std::vector<ScanSource>& scans) {
+  for (const ScanSource& scan : scans) {
+    if (scan.load.format != CloudFormat::kDepthPng)
+      return DefaultOverlapThreshold(scan.load.format);
+  }
+  return DefaultOverlapThreshold(CloudFormat::kDepthPng);
+}
+
+std::string DoubtfulSummary(int doubtful, int total) {
+  return std::to_string(doubtful) + " of " + std::to_string(total) + " pairs doubtful";
+}
+
+PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config) {
+  PoseGraphOptions options;
+  options.max_correspondence_distance = job_config.EffectiveInlierDistance();
+  return options;
+}
+
+}  // namespace boicp

@@ -1,0 +1,139 @@
+#include "boicp/mapping/map_assembly.hpp"
+
+#include <chrono>
+#include <fstream>
+
+#include "boicp/util/atomic_file.hpp"
+#include "boicp/io/trajectory_io.hpp"
+#include "boicp/registration/voxel_cloud.hpp"
+
+namespace boicp {
+namespace {
+
+void Report(const AssemblyCallbacks& callbacks, const std::string& stage, int done, int total) {
+  if (callbacks.progress) callbacks.progress({stage, done, total});
+}
+
+void ThrowIfStopped(const AssemblyCallbacks& callbacks) {
+  if (callbacks.stop_requested && callbacks.stop_requested()) throw Cancelled();
+}
+
+// Points no farther than max_range from the sensor origin (all when 0).
+Points WithinRange(const Points& points, const Point& origin, double max_range) {
+  if (max_range <= 0.0) return points;
+  Points kept;
+  kept.reserve(points.size());
+  const double max_sq = max_range * max_range;
+  for (const Point& p : points) {
+    if ((p - origin).squaredNorm() <= max_sq) kept.push_back(p);
+  }
+  return kept;
+}
+
+void WriteText(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  WriteFileAtomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::trunc);
+    write(out);
+    if (!out.flush()) throw std::runtime_error(tmp + ": write failed");
+  });
+}
+
+}  // namespace
+
+std::optional<Transform> PairPrior(const ScanSource& source, const ScanSource& target) {
+  if (!source.prior_pose || !target.prior_pose) return std::nullopt;
+  return Transform(target.prior_pose->inverse() * *source.prior_pose);
+}
+
+std::vector<double> ScanTimestamps(const std::vector<ScanSource>& scans) {
+  std::vector<double> stamps;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    stamps.push_back(scans[i].timestamp.value_or(static_cast<double>(i)));
+  }
+  return stamps;
+}
+
+PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
+                           const std::vector<PairConstraint>& constraints,
+                           const PoseGraphOptions& options) {
+  const Transform anchor =
+      !scans.empty() && scans[0].prior_pose ? *scans[0].prior_pose : Transform::Identity();
+  const ChainedPoses chained = ChainPoses(static_cast<int>(scans.size()), constraints, anchor);
+  PoseEstimate estimate;
+  estimate.loop_closures = chained.loop_closures;
+  if (chained.loop_closures == 0) {
+    estimate.poses = chained.poses;
+    estimate.kept.assign(constraints.size(), true);
+    return estimate;
+  }
+  OptimizedPoses optimised =
+      OptimizePoseGraph(chained.poses, constraints, chained.in_tree, options);
+  estimate.poses = std::move(optimised.poses);
+  estimate.kept = std::move(optimised.kept);
+  estimate.optimised = true;
+  return estimate;
+}
+
+FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
+                        const MapBuildSettings& settings, const MapOutputPaths& outputs,
+                        const AssemblyCallbacks& callbacks) {
+  const auto start = std::chrono::steady_clock::now();
+  if (poses.size() != scans.size()) {
+    throw InputError("map assembly: " + std::to_string(poses.size()) + " poses for " +
+                     std::to_string(scans.size()) + " scans");
+  }
+  OccupancyMap map(settings.occupancy);
+  const double cloud_voxel =
+      settings.cloud_voxel > 0.0 ? settings.cloud_voxel : settings.occupancy.resolution;
+  VoxelAccumulator cloud(cloud_voxel);
+  const bool want_cloud = !outputs.cloud_ply.empty();
+  const int total = static_cast<int>(scans.size());
+
+  for (int i = 0; i < total; ++i) {
+    ThrowIfStopped(callbacks);
+    const ScanSource& scan = scans[static_cast<size_t>(i)];
+    const Points points = LoadPointCloud(scan.path, scan.load).points;
+    map.InsertScan(points, poses[static_cast<size_t>(i)], scan.sensor_origin);
+    if (want_cloud) {
+      cloud.Add(WithinRange(points, scan.sensor_origin, settings.occupancy.max_range),
+                poses[static_cast<size_t>(i)]);
+    }
+    Report(callbacks, "fusing", i + 1, total);
+  }
+
+  ThrowIfStopped(callbacks);
+  Report(callbacks, "writing", 0, 1);
+  FusionSummary summary;
+  summary.occupied_leaves = map.OccupiedLeaves();
+  // The .ot keeps full probabilities, so it goes before the .bt conversion.
+  // A stop request is honoured between outputs too: each write is atomic,
+  // so a stopped job leaves whole files, and its rerun rewrites them all.
+  if (!outputs.octomap_ot.empty()) {
+    WriteFileAtomically(outputs.octomap_ot, [&](const std::string& tmp) { map.WriteFull(tmp); });
+  }
+  ThrowIfStopped(callbacks);
+  if (!outputs.octomap_bt.empty()) {
+    WriteFileAtomically(outputs.octomap_bt, [&](const std::string& tmp) { map.WriteBinary(tmp); });
+  }
+  ThrowIfStopped(callbacks);
+  if (!outputs.trajectory_tum.empty()) {
+    WriteText(outputs.trajectory_tum,
+              [&](std::ostream& out) { WriteTumTrajectory(out, ScanTimestamps(scans), poses); });
+  }
+  if (!outputs.trajectory_kitti.empty()) {
+    WriteText(outputs.trajectory_kitti,
+              [&](std::ostream& out) { WriteKittiTrajectory(out, poses); });
+  }
+  ThrowIfStopped(callbacks);
+  if (want_cloud) {
+    const Points merged = cloud.Centroids();
+    summary.cloud_points = merged.size();
+    WriteFileAtomically(outputs.cloud_ply,
+                        [&](const std::string& tmp) { WritePlyPoints(tmp, merged); });
+  }
+  Report(callbacks, "writing", 1, 1);
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace boicp

@@ -1,0 +1,116 @@
+#include "boicp/mapping/map_pairs.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <set>
+#include <string>
+
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+namespace {
+
+std::string PairName(const PairIndex& p) {
+  return "(" + std::to_string(p.source) + " -> " + std::to_string(p.target) + ")";
+}
+
+uint64_t SplitMix64(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+int FindRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+}  // namespace
+
+std::vector<PairIndex> ConsecutivePairs(int num_scans) {
+  std::vector<PairIndex> pairs;
+  for (int i = 0; i + 1 < num_scans; ++i) pairs.push_back({i, i + 1});
+  return pairs;
+}
+
+void ValidatePairs(int num_scans, const std::vector<PairIndex>& pairs, bool require_connected) {
+  std::set<std::pair<int, int>> seen;
+  std::vector<int> parent(static_cast<size_t>(std::max(num_scans, 0)));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const PairIndex& p = pairs[i];
+    const std::string where = "pair " + std::to_string(i) + " " + PairName(p);
+    if (p.source < 0 || p.source >= num_scans || p.target < 0 || p.target >= num_scans) {
+      throw InputError(where + ": scan index out of range (the batch has " +
+                       std::to_string(num_scans) + " scans)");
+    }
+    if (p.source == p.target) throw InputError(where + ": a scan cannot be paired with itself");
+    const auto key = std::minmax(p.source, p.target);
+    if (!seen.insert({key.first, key.second}).second) {
+      throw InputError(where + ": the same two scans are already paired");
+    }
+    parent[FindRoot(parent, p.source)] = FindRoot(parent, p.target);
+  }
+  if (!require_connected) return;
+  for (int i = 1; i < num_scans; ++i) {
+    if (FindRoot(parent, i) != FindRoot(parent, 0)) {
+      throw InputError("the pairs do not connect scan " + std::to_string(i) +
+                       " to scan 0; every scan needs a chain of pairs to the others");
+    }
+  }
+}
+
+uint64_t PairSeed(uint64_t job_seed, const PairIndex& pair) {
+  const uint64_t packed = (static_cast<uint64_t>(static_cast<uint32_t>(pair.source)) << 32) |
+                          static_cast<uint32_t>(pair.target);
+  return SplitMix64(SplitMix64(job_seed) ^ packed);
+}
+
+double DefaultOverlapThreshold(CloudFormat format) {
+  return format == CloudFormat::kDepthPng ? 0.6 : 0.7;
+}
+
+KeyframePlanner::KeyframePlanner(int num_scans, double overlap_threshold)
+    : num_scans_(num_scans), threshold_(overlap_threshold) {
+  if (num_scans < 1) throw InputError("keyframes: a batch needs at least one scan");
+  if (!(overlap_threshold > 0.0 && overlap_threshold <= 1.0)) {
+    throw InputError("keyframes: overlap threshold must be in (0, 1]");
+  }
+}
+
+std::vector<PairIndex> KeyframePlanner::NextProbes(int max_count) {
+  std::vector<PairIndex> probes;
+  while (static_cast<int>(probes.size()) < max_count && next_probe_ < num_scans_) {
+    const PairIndex probe{next_probe_++, keyframe_};
+    if (overlap_.count(probe) == 0) probes.push_back(probe);
+  }
+  return probes;
+}
+
+void KeyframePlanner::Record(const PairIndex& pair, double overlap) {
+  overlap_[pair] = overlap;
+  Advance();
+}
+
+void KeyframePlanner::Advance() {
+  while (next_ < num_scans_) {
+    const PairIndex probe{next_, keyframe_};
+    const auto found = overlap_.find(probe);
+    if (found == overlap_.end()) return;
+    if (found->second >= threshold_ || next_ == keyframe_ + 1) {
+      chain_.push_back(probe);
+      ++next_;
+      continue;
+    }
+    // Scan next_ sees too little of the keyframe: the scan before it takes
+    // over as keyframe and next_ is probed again against that one.
+    keyframe_ = next_ - 1;
+    next_probe_ = next_;
+  }
+}
+
+}  // namespace boicp

@@ -1,0 +1,295 @@
+#include "boicp/registration/auto_settings.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <open3d/geometry/KDTreeFlann.h>
+#include <open3d/geometry/PointCloud.h>
+
+#include "boicp/registration/preprocess.hpp"
+
+namespace boicp {
+namespace {
+
+// The rules below were read off the shared KITTI, 7-Scenes and bunny scans
+// (bench/README.md, "Automatic settings"); each is a ratio to the scene's own
+// size, so no rule names a sensor's range or a dataset.
+
+// Search voxel = RMS radius / 25. Coarse enough that ICP's basin (3 voxels)
+// spans the gaps between a scene's main surfaces, fine enough that about 25
+// voxels across the scene keep its shape: 0.6 m for a street, 4 cm for a
+// room, 2.5 mm for a 6 cm object.
+constexpr double kRadiusPerVoxel = 25.0;
+// A doubtful answer is searched for again 4 voxels coarser (RMS radius / 6):
+// the scale at which a small object's views, or low-overlap views, still
+// share their coarse shape.
+constexpr double kRetryVoxelScale = 4.0;
+// Translation box half-width, the search box being centred where the two
+// centroids meet. A view from a cone (a camera, a scanner facing an object)
+// that turns or moves sees other parts of the scene, so the centroids of two
+// views can lie as far apart as the scene's RMS radius. An all-around scan
+// that moves keeps seeing most of what it saw, so its centroid follows the
+// motion, a quarter of the radius; on level ground its height barely changes,
+// so z gets only the minimum: two search voxels, which every axis gets at
+// least so that it still holds a basin or two.
+constexpr double kConeTranslationPerRadius = 1.0;
+constexpr double kAllAroundTranslationPerRadius = 0.25;
+constexpr double kMinTranslationBoundVoxels = 2.0;
+// A spinning LiDAR sees every side of its origin; a depth camera or a scanner
+// of objects sees one cone.
+constexpr int kAzimuthSectors = 36;
+constexpr int kAllAroundSectors = 32;
+constexpr double kMaxAllAroundDirection = 0.5;  // norm of the mean unit direction
+// Ground: the largest plane below the origin, holding at least a sixth of the
+// points, with its normal within 15 degrees of +z. A car's roll and pitch then
+// stay within a few degrees of the scan's own.
+constexpr double kMinGroundShare = 1.0 / 6.0;
+constexpr double kMaxGroundTilt = 15.0 * M_PI / 180.0;
+constexpr double kLevelRollPitchBound = 0.2;  // radians, for two scans on level ground
+constexpr int kPlaneTrials = 200;
+// Points measured (random, seeded): statistics of 20,000 points differ from
+// those of the whole cloud by far less than the rules' precision.
+constexpr size_t kMeasuredPoints = 20000;
+constexpr size_t kSpacingQueries = 1000;
+
+double Percentile(std::vector<double> values, double q) {
+  const size_t k = static_cast<size_t>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+bool SeesAllAround(const Points& points) {
+  // A cone of view (a camera's, or an object seen from one side) has its
+  // directions from the origin mostly alike, whatever their azimuths.
+  Eigen::Vector3d mean_direction = Eigen::Vector3d::Zero();
+  for (const Point& p : points) {
+    if (p.norm() > 0.0) mean_direction += p.normalized();
+  }
+  if (mean_direction.norm() > kMaxAllAroundDirection * static_cast<double>(points.size())) {
+    return false;
+  }
+  std::vector<bool> seen(kAzimuthSectors, false);
+  for (const Point& p : points) {
+    const double azimuth = std::atan2(p.y(), p.x()) + M_PI;  // [0, 2 pi]
+    const int sector =
+        std::min(kAzimuthSectors - 1, static_cast<int>(azimuth / (2.0 * M_PI) * kAzimuthSectors));
+    seen[static_cast<size_t>(sector)] = true;
+  }
+  return std::count(seen.begin(), seen.end(), true) >= kAllAroundSectors;
+}
+
+// RANSAC (seeded) for the near-horizontal plane with the most points within
+// `tolerance` metres. Returns the angle between its normal and +z when it
+// holds kMinGroundShare of the points and lies below the origin.
+std::optional<double> GroundTilt(const Points& points, double tolerance, uint64_t seed) {
+  if (points.size() < 3) return std::nullopt;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
+  size_t best_count = 0;
+  Eigen::Vector3d best_normal = Eigen::Vector3d::UnitZ();
+  double best_offset = 0.0;
+  for (int trial = 0; trial < kPlaneTrials; ++trial) {
+    const Point& a = points[pick(rng)];
+    const Point& b = points[pick(rng)];
+    const Point& c = points[pick(rng)];
+    Eigen::Vector3d normal = (b - a).cross(c - a);
+    if (normal.norm() < 1e-12) continue;
+    normal.normalize();
+    if (normal.z() < 0) normal = -normal;
+    if (std::acos(std::min(1.0, normal.z())) > kMaxGroundTilt) continue;
+    const double offset = -normal.dot(a);  // plane: normal . p + offset = 0
+    const size_t count =
+        static_cast<size_t>(std::count_if(points.begin(), points.end(), [&](const Point& p) {
+          return std::abs(normal.dot(p) + offset) < tolerance;
+        }));
+    if (count > best_count) {
+      best_count = count;
+      best_normal = normal;
+      best_offset = offset;
+    }
+  }
+  // The origin must lie above the plane (offset > 0 with the normal up).
+  if (static_cast<double>(best_count) < kMinGroundShare * static_cast<double>(points.size()) ||
+      best_offset <= 0.0) {
+    return std::nullopt;
+  }
+  return std::acos(std::min(1.0, best_normal.z()));
+}
+
+double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
+
+// Median distance from a point to its nearest other point, over
+// kSpacingQueries random points (seeded) against the whole cloud.
+double PointSpacing(const Points& cloud, uint64_t seed) {
+  const open3d::geometry::PointCloud o3d(cloud);
+  const open3d::geometry::KDTreeFlann tree(o3d);
+  std::vector<double> gaps;
+  std::vector<int> indices;
+  std::vector<double> squared;
+  for (const Point& p : RandomSubsample(cloud, kSpacingQueries, seed)) {
+    if (tree.SearchKNN(p, 2, indices, squared) == 2) gaps.push_back(std::sqrt(squared[1]));
+  }
+  return gaps.empty() ? 0.0 : Median(gaps);
+}
+
+// The finest refinement level: two point spacings, the finest voxel that
+// still averages a few points, but between a sixteenth and a quarter of the
+// search voxel, so the pyramid is two to four levels deep.
+double RefineVoxel(double voxel, double spacing) {
+  return std::clamp(2.0 * spacing, voxel / 16.0, voxel / 4.0);
+}
+
+}  // namespace
+
+std::string SensorKindName(SensorKind kind) {
+  switch (kind) {
+    case SensorKind::kLidar:
+      return "lidar";
+    case SensorKind::kDepthCamera:
+      return "depth camera";
+    case SensorKind::kOther:
+      break;
+  }
+  return "other";
+}
+
+CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
+  const std::string advice =
+      " to choose settings from; give --voxel and --translation-bounds (or --fixed-settings)";
+  if (cloud.size() < kMinPointsForSettings) {
+    throw InputError("a cloud has " + std::to_string(cloud.size()) + " points, too few" + advice);
+  }
+  const Points points = RandomSubsample(cloud, kMeasuredPoints, seed);
+  CloudStatistics stats;
+  stats.points = cloud.size();
+  const Point centroid = Centroid(points);
+  Eigen::Vector3d squares = Eigen::Vector3d::Zero();
+  std::vector<double> ranges;
+  ranges.reserve(points.size());
+  for (const Point& p : points) {
+    squares += (p - centroid).cwiseAbs2();
+    ranges.push_back(p.norm());
+  }
+  squares /= static_cast<double>(points.size());
+  stats.rms_radius = std::sqrt(squares.sum());
+  if (!(stats.rms_radius > 1e-9)) {
+    throw InputError("a cloud has all its points in one place, nothing" + advice);
+  }
+  stats.range_p95 = Percentile(ranges, 0.95);
+  stats.spacing = PointSpacing(cloud, seed);
+  stats.all_around = SeesAllAround(points);
+  const double voxel = stats.rms_radius / kRadiusPerVoxel;
+  stats.ground_tilt = GroundTilt(VoxelDownsample(points, voxel / 2), voxel / 2, seed + 1);
+  return stats;
+}
+
+ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format) {
+  if (stats.empty()) throw InputError("automatic settings need at least one cloud");
+  std::vector<double> radii, ranges, spacings, tilts;
+  bool all_around = true, level = true;
+  for (const CloudStatistics& s : stats) {
+    radii.push_back(s.rms_radius);
+    ranges.push_back(s.range_p95);
+    spacings.push_back(s.spacing);
+    all_around = all_around && s.all_around;
+    level = level && s.ground_tilt.has_value();
+    if (s.ground_tilt) tilts.push_back(*s.ground_tilt);
+  }
+  ChosenSettings chosen;
+  if (format == CloudFormat::kKittiBin || (format != CloudFormat::kDepthPng && all_around)) {
+    chosen.sensor = SensorKind::kLidar;
+  } else if (format == CloudFormat::kDepthPng) {
+    chosen.sensor = SensorKind::kDepthCamera;
+  }
+  chosen.voxel = Median(radii) / kRadiusPerVoxel;
+  chosen.point_spacing = Median(spacings);
+  const double radius = Median(radii);
+  chosen.translation_bounds.setConstant(
+      (all_around ? kAllAroundTranslationPerRadius : kConeTranslationPerRadius) * radius);
+  if (all_around && level) chosen.translation_bounds.z() = 0.0;  // raised to the minimum below
+  chosen.translation_bounds = chosen.translation_bounds.cwiseMax(
+      Eigen::Vector3d::Constant(kMinTranslationBoundVoxels * chosen.voxel));
+  if (chosen.sensor == SensorKind::kLidar && level) {
+    // Both scans on level ground: their roll and pitch differ by at most
+    // the two tilts, so a small box holds them; yaw stays free.
+    const double tilt = *std::max_element(tilts.begin(), tilts.end());
+    const double roll_pitch = std::max(kLevelRollPitchBound, 2.0 * tilt);
+    chosen.rotation_bounds = {roll_pitch, roll_pitch, M_PI};
+  } else {
+    chosen.rotation_bounds = {M_PI, M_PI / 2, M_PI};
+  }
+  // A third of the search voxel keeps walls and kerbs a few cells thick.
+  chosen.map_resolution = chosen.voxel / 3.0;
+  // The sparse far tail of a scan costs most of the ray casting (cost grows
+  // with the ray's length) and carries the least structure.
+  chosen.map_max_range = Median(ranges);
+  return chosen;
+}
+
+ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds, CloudFormat format,
+                                       uint64_t seed, size_t max_clouds) {
+  if (clouds.empty()) throw InputError("automatic settings need at least one cloud");
+  const size_t count = std::min(std::max<size_t>(max_clouds, 1), clouds.size());
+  std::vector<CloudStatistics> stats;
+  for (size_t k = 0; k < count; ++k) {
+    const size_t index = count == 1 ? 0 : k * (clouds.size() - 1) / (count - 1);
+    stats.push_back(MeasureCloud(*clouds[index], seed + index));
+  }
+  return ChooseSettings(stats, format);
+}
+
+std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcpConfig& config) {
+  const auto automatic = [&](const std::string& field) {
+    return std::find(config.automatic.begin(), config.automatic.end(), field) !=
+           config.automatic.end();
+  };
+  // The presets' voxels keep their ratio (A and B search 7/6 coarser than C).
+  const double preset_scale = PresetConfig(config.preset).voxel / PresetConfig("C").voxel;
+  std::vector<std::string> set;
+  for (const std::string& field : kAutoRegistrationFields) {
+    if (!automatic(field)) continue;
+    set.push_back(field);
+    if (field == "voxel") {
+      config.voxel = chosen.voxel * preset_scale;
+      config.retry_voxel = kRetryVoxelScale * config.voxel;
+    }
+    if (field == "refine_voxel")
+      config.refine_voxel = RefineVoxel(config.voxel, chosen.point_spacing);
+    // Tighter than ICP's 3-voxel gate, so a looser but larger overlap (a
+    // view slid along a wall) does not outscore the true one.
+    if (field == "objective_truncation") config.objective_truncation = 1.5 * config.voxel;
+    if (field == "translation_bounds") config.translation_bounds = chosen.translation_bounds;
+    if (field == "rotation_bounds") config.rotation_bounds = chosen.rotation_bounds;
+  }
+  config.automatic.clear();
+  return set;
+}
+
+}  // namespace boicp
+
+namespace boicp {
+
+std::string DescribeSettings(const BoIcpConfig& config, const std::vector<std::string>& auto_fields,
+                             SensorKind sensor) {
+  const auto mark = [&](const std::string& field) {
+    return std::find(auto_fields.begin(), auto_fields.end(), field) != auto_fields.end() ? " (auto)"
+                                                                                         : "";
+  };
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "preset %s, %s search, sensor %s: voxel %.3g m%s, refine voxel %.3g m%s, "
+                "translation bounds %.3g,%.3g,%.3g m%s, rotation bounds %.3g,%.3g,%.3g rad%s, "
+                "%d threads, seed %llu",
+                config.preset.c_str(), SearchModeName(config.mode).c_str(),
+                SensorKindName(sensor).c_str(), config.voxel, mark("voxel"),
+                config.EffectiveRefineVoxel(), mark("refine_voxel"), config.translation_bounds[0],
+                config.translation_bounds[1], config.translation_bounds[2],
+                mark("translation_bounds"), config.rotation_bounds[0], config.rotation_bounds[1],
+                config.rotation_bounds[2], mark("rotation_bounds"), config.threads,
+                static_cast<unsigned long long>(config.seed));
+  return text;
+}
+
+}  // namespace boicp

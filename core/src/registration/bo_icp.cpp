@@ -1,0 +1,360 @@
+
+#include "boicp/registration/bo_icp.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <mutex>
+#include <utility>
+
+#include "boicp/registration/alignment_score.hpp"
+#include "boicp/registration/auto_settings.hpp"
+#include "boicp/registration/icp.hpp"
+#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/registration/preprocess.hpp"
+#include "boicp/registration/refinement.hpp"
+#include "boicp/registration/search_space.hpp"
+
+namespace boicp {
+namespace {
+
+// Distinct seeds for the independent random choices of one registration.
+constexpr uint64_t kSubsampleSalt = 0x9e3779b97f4a7c15ULL;
+constexpr uint64_t kStageSalt = 0xbf58476d1ce4e5b9ULL;
+constexpr uint64_t kCoarseSalt = 0x94d049bb133111ebULL;
+
+// Everything one registration evaluates against, built once per pair.
+struct PairContext {
+  const PreparedPair& prepared;
+  Points evaluation_source;  // subsample of prepared.search_source used by every BO evaluation
+  Points coarse_source;      // subsample of evaluation_source for the first part of each ICP run
+  IcpOptions search_icp;
+};
+
+class Search {
+  struct Finished {
+    Eigen::VectorXd x;
+    Evaluation evaluation;
+    bool converged;  // its end may be joined by later runs
+  };
+
+ public:
+  Search(const PairContext& pair, const BoIcpConfig& config, const RegistrationCallbacks& callbacks)
+      : pair_(pair), config_(config), callbacks_(callbacks) {}
+
+  // Runs one BO stage over `space`; the box centre (the anchor) is the first
+  // sample, followed by `extra_starts` (unit coordinates).
+  BayesOptResult RunStage(int stage, const SearchSpace& space, const std::string& name,
+                          const std::vector<Eigen::VectorXd>& extra_starts = {}) {
+    BayesOptOptions options = config_.bo;
+    options.initial_samples = config_.random_samples;
+    options.iterations = config_.iterations;
+    options.threads = config_.threads;
+    std::mutex mutex;
+    std::vector<Finished> finished;
+    size_t committed = 0;  // entries of `finished` whose ends are in known_ends_
+    const BoundedObjective objective = [&](const Eigen::VectorXd& u, double /*incumbent*/) {
+      bool converged = false;
+      const Evaluation evaluation = Evaluate(stage, space.ToTransform(u), converged);
+      const std::lock_guard<std::mutex> lock(mutex);
+      finished.push_back({u, evaluation, converged});
+      return evaluation.objective;
+    };
+    // Progress comes once a round is complete, so every run of a round sees
+    // the same known ends, whatever the thread count.
+    const BayesOptProgress progress = [&](int done, int total, double best) {
+      for (; committed < finished.size(); ++committed) {
+        if (!finished[committed].converged) continue;
+        known_ends_.push_back(finished[committed].evaluation.result);
+        known_objectives_.push_back(finished[committed].evaluation.objective);
+      }
+      if (callbacks_.progress) callbacks_.progress({name, done, total, best});
+    };
+    std::vector<Eigen::VectorXd> starts = {Eigen::VectorXd::Constant(space.dimension(), 0.5)};
+    starts.insert(starts.end(), extra_starts.begin(), extra_starts.end());
+    BayesOptResult result =
+        MinimiseBayesOpt(objective, space.Periodic(), options,
+                         config_.seed ^ (kStageSalt * static_cast<uint64_t>(stage + 1)), starts,
+                         progress, callbacks_.stop_requested);
+    AppendInProposalOrder(result.history, finished);
+    return result;
+  }
+
+  const Evaluation& Best() const {
+    return *std::min_element(
+        history_.begin(), history_.end(),
+        [](const Evaluation& a, const Evaluation& b) { return a.objective < b.objective; });
+  }
+  std::vector<Evaluation>& history() { return history_; }
+
+ private:
+  // The paper's objective: the error ICP reaches when started from T0. Runs
+  // that reach the end of an earlier run take over its result. `converged`
+  // tells whether the run found an end of its own.
+  Evaluation Evaluate(int stage, const Transform& initial, bool& converged) const {
+    const NearestNeighborIndex& target = pair_.prepared.search_target;
+    Evaluation evaluation{stage, initial, initial, 0.0};
+    converged = false;
+    if (callbacks_.local_icp) {
+      evaluation.result = callbacks_.local_icp(pair_.evaluation_source, target.points(), initial);
+    } else {
+      IcpOptions options = pair_.search_icp;
+      IcpResult icp;
+      icp.transform = initial;
+      if (pair_.coarse_source.size() < pair_.evaluation_source.size()) {
+        icp = AlignPointToPoint(pair_.coarse_source, target, initial, options, known_ends_);
+        options.max_iterations =
+            std::max(options.max_iterations - icp.iterations, config_.finish_icp_iterations);
+      }
+      if (icp.joined_end < 0) {
+        icp =
+            AlignPointToPoint(pair_.evaluation_source, target, icp.transform, options, known_ends_);
+      }
+      evaluation.result = icp.transform;
+      if (icp.joined_end >= 0) {
+        evaluation.objective = known_objectives_[icp.joined_end];
+        return evaluation;
+      }
+      converged = icp.converged;
+    }
+    evaluation.objective = ScoreAlignment(pair_.evaluation_source, target, evaluation.result,
+                                          config_.EffectiveTruncation())
+                               .truncated_mean;
+    return evaluation;
+  }
+
+  // Evaluations of a round finish in any order; the history keeps the order
+  // in which BO proposed them, so it does not depend on the thread count.
+  void AppendInProposalOrder(const std::vector<BayesOptSample>& proposals,
+                             std::vector<Finished>& finished) {
+    for (const BayesOptSample& sample : proposals) {
+      const auto match = std::find_if(finished.begin(), finished.end(),
+                                      [&](const Finished& entry) { return entry.x == sample.x; });
+      history_.push_back(match->evaluation);
+      finished.erase(match);
+    }
+  }
+
+  const PairContext& pair_;
+  const BoIcpConfig& config_;
+  const RegistrationCallbacks& callbacks_;
+  std::vector<Evaluation> history_;
+  // Ends of the converged runs of finished rounds (all stages: they share the
+  // ICP problem), and their objectives.
+  std::vector<Transform> known_ends_;
+  std::vector<double> known_objectives_;
+};
+
+// Unit coordinates of translation t in a translation-only search box, clamped
+// into the box.
+Eigen::VectorXd TranslationToUnit(const SearchSpace& space, const Eigen::Vector3d& t) {
+  const Eigen::Vector3d offset = t - space.anchor.topRightCorner<3, 1>();
+  Eigen::VectorXd u(space.dimension());
+  for (int k = 0; k < space.dimension(); ++k) {
+    const int p = space.parameters[k];
+    u[k] = std::clamp(0.5 + offset[p - kX] / (2.0 * space.half_widths[p]), 0.0, 1.0);
+  }
+  return u;
+}
+
+bool SameBasin(const Transform& a, const Transform& b, double voxel) {
+  const Transform delta = a.inverse() * b;
+  return RotationAngle(delta) < 5.0 * M_PI / 180.0 && TranslationNorm(delta) < 3.0 * voxel;
+}
+
+// The best search results that ended in different basins, best first, at most `count`.
+std::vector<Evaluation> DistinctBest(std::vector<Evaluation> history, int count, double voxel) {
+  std::sort(history.begin(), history.end(),
+            [](const Evaluation& a, const Evaluation& b) { return a.objective < b.objective; });
+  std::vector<Evaluation> picked;
+  for (const Evaluation& e : history) {
+    if (static_cast<int>(picked.size()) >= count) break;
+    const bool repeats = std::any_of(picked.begin(), picked.end(), [&](const Evaluation& p) {
+      return SameBasin(p.result, e.result, voxel);
+    });
+    if (!repeats) picked.push_back(e);
+  }
+  return picked;
+}
+
+// Share of the first stage's runs (the ones that started from anywhere in
+// the box) that ended in the basin of `answer`.
+double BasinSupport(const std::vector<Evaluation>& history, const Transform& answer, double voxel) {
+  int first_stage = 0, in_basin = 0;
+  for (const Evaluation& e : history) {
+    if (e.stage != 0) continue;
+    ++first_stage;
+    in_basin += SameBasin(answer, e.result, voxel) ? 1 : 0;
+  }
+  return first_stage > 0 ? static_cast<double>(in_basin) / first_stage : 0.0;
+}
+
+// One search (nested or 6 DOF) and the refinement of its distinct best ends.
+struct SearchOutcome {
+  RefinedAlignment refined;
+  double overlap = 0.0;  // RegistrationResult::overlap of the refined answer
+  size_t source_points = 0, target_points = 0;
+  double objective = 0.0;  // best search objective
+  double probability_better = 0.0;
+  double gp_mean = 0.0, gp_std = 0.0;
+  std::vector<Evaluation> history;
+  ConfidenceFeatures features;
+  double confidence = 0.0;
+};
+
+SearchOutcome SearchAndRefine(const Points& source, const Points& target, const BoIcpConfig& config,
+                              const std::optional<Transform>& prior,
+                              const RegistrationCallbacks& callbacks) {
+  const PreparedPair prepared = PreparePair(source, target, config);
+  Points evaluation_source = RandomSubsample(prepared.search_source, config.evaluation_points,
+                                             config.seed ^ kSubsampleSalt);
+  Points coarse_source =  // 0 points: all of them, so there is no separate first part
+      RandomSubsample(evaluation_source, config.coarse_icp_points, config.seed ^ kCoarseSalt);
+  const PairContext pair{prepared, std::move(evaluation_source), std::move(coarse_source),
+                         SearchIcpOptions(config)};
+  const Points& search_source = prepared.search_source;
+
+  // Without a prior the box is centred on "same orientation, centroids on top
+  // of each other"; with one, on the prior itself.
+  const Transform anchor = prior.value_or([&] {
+    Transform centroids = Transform::Identity();
+    centroids.topRightCorner<3, 1>() =
+        Centroid(prepared.search_target.points()) - Centroid(search_source);
+    return centroids;
+  }());
+  const Point pivot =
+      anchor.topLeftCorner<3, 3>() * Centroid(search_source) + anchor.topRightCorner<3, 1>();
+
+  Search search(pair, config, callbacks);
+  SearchOutcome out;
+  BayesOptResult last;
+  if (config.mode == SearchMode::kNested) {
+    const BayesOptResult rotation = search.RunStage(
+        0, MakeSearchSpace(anchor, pivot, config.rotation_bounds, Eigen::Vector3d::Zero()),
+        "rotation");
+    // The translation stage fixes the ICP-refined best rotation. Its box is
+    // centred where that rotation about the pivot puts the source, not on the
+    // ICP result: with partial overlap ICP may have slid far from the truth.
+    // The ICP result itself is the second sample.
+    const Transform rotated = search.Best().result;
+    Transform centred = rotated;
+    centred.topRightCorner<3, 1>() =
+        pivot - rotated.topLeftCorner<3, 3>() * Centroid(search_source);
+    const SearchSpace translation =
+        MakeSearchSpace(centred, pivot, Eigen::Vector3d::Zero(), config.translation_bounds);
+    last = search.RunStage(1, translation, "translation",
+                           {TranslationToUnit(translation, rotated.topRightCorner<3, 1>())});
+    out.probability_better = std::max(rotation.probability_better, last.probability_better);
+  } else {
+    last = search.RunStage(
+        0, MakeSearchSpace(anchor, pivot, config.rotation_bounds, config.translation_bounds),
+        "6dof");
+    out.probability_better = last.probability_better;
+  }
+  out.objective = search.Best().objective;
+
+  // The search objective is measured on coarse voxels; a few distinct
+  // candidates are refined and compared at the finest level.
+  std::vector<Transform> candidates;
+  for (const Evaluation& e : DistinctBest(search.history(), config.refine_candidates, config.voxel))
+    candidates.push_back(e.result);
+  if (callbacks.progress) callbacks.progress({"refine", 0, 1, out.objective});
+  out.refined = RefineCoarseToFine(candidates, pair.prepared, config);
+  if (callbacks.progress) callbacks.progress({"refine", 1, 1, out.objective});
+
+  out.gp_mean = last.gp_mean_at_best;
+  out.gp_std = last.gp_std_at_best;
+  out.history = std::move(search.history());
+  out.features.fitness = out.refined.score.fitness;
+  out.features.rmse_ratio = out.refined.score.inlier_rmse / config.EffectiveInlierDistance();
+  out.features.margin = out.refined.margin;
+  out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
+  out.features.probability_better = out.probability_better;
+  out.confidence = Confidence(out.features);
+  out.overlap = ScoreAlignment(search_source, prepared.search_target, out.refined.transform,
+                               1.5 * config.voxel, config.threads)
+                    .fitness;
+  out.source_points = search_source.size();
+  out.target_points = prepared.search_target.size();
+  return out;
+}
+
+// The seed of a retry: another stream of the same job seed.
+uint64_t RetrySeed(uint64_t seed) { return seed ^ 0xa0761d6478bd642fULL; }
+
+// The retry of a doubtful search: in 6 DOF, with another seed, and at
+// config.retry_voxel when set. The finest refinement level stays, so both
+// answers' fitness is measured alike.
+BoIcpConfig RetryConfig(const BoIcpConfig& config) {
+  BoIcpConfig retry = config;
+  retry.mode = SearchMode::kSixDof;
+  retry.seed = RetrySeed(config.seed);
+  if (config.retry_voxel > 0.0) {
+    const double scale = config.retry_voxel / config.voxel;
+    retry.refine_voxel = config.EffectiveRefineVoxel();
+    retry.objective_truncation = config.EffectiveTruncation() * scale;
+    retry.max_correspondence_distance = config.EffectiveMaxCorrespondence() * scale;
+    retry.voxel = config.retry_voxel;
+  }
+  return retry;
+}
+
+}  // namespace
+
+RegistrationResult RegisterPair(const Points& source, const Points& target,
+                                const BoIcpConfig& requested, const std::optional<Transform>& prior,
+                                const RegistrationCallbacks& callbacks) {
+  const auto started = std::chrono::steady_clock::now();
+  BoIcpConfig config = requested;
+  std::vector<std::string> auto_fields;
+  if (!config.automatic.empty()) {
+    auto_fields = ApplyChosenSettings(
+        ChooseSettingsForClouds({&source, &target}, CloudFormat::kAuto, config.seed), config);
+  }
+  ValidateConfig(config);
+
+  RegistrationResult result;
+  const auto attempt = [&](const BoIcpConfig& attempt_config) {
+    const auto attempt_started = std::chrono::steady_clock::now();
+    SearchOutcome outcome = SearchAndRefine(source, target, attempt_config, prior, callbacks);
+    result.attempts.push_back(
+        {attempt_config.mode, attempt_config.seed, outcome.refined.score.fitness,
+         outcome.confidence, static_cast<int>(outcome.history.size()),
+         std::chrono::duration<double>(std::chrono::steady_clock::now() - attempt_started).count(),
+         false});
+    return outcome;
+  };
+  SearchOutcome kept = attempt(config);
+  size_t kept_index = 0;
+  if (config.retry_when_doubtful && kept.confidence < kDoubtfulBelow) {
+    SearchOutcome second = attempt(RetryConfig(config));
+    if (second.refined.score.fitness > kept.refined.score.fitness) {
+      kept = std::move(second);
+      kept_index = 1;
+    }
+  }
+  result.attempts[kept_index].kept = true;
+
+  result.transform = kept.refined.transform;
+  result.objective = kept.objective;
+  result.fitness = kept.refined.score.fitness;
+  result.inlier_rmse = kept.refined.score.inlier_rmse;
+  result.overlap = kept.overlap;
+  result.probability_better = kept.probability_better;
+  result.features = kept.features;
+  result.confidence = kept.confidence;
+  result.doubtful = result.confidence < kDoubtfulBelow;
+  result.gp_mean = kept.gp_mean;
+  result.gp_std = kept.gp_std;
+  result.evaluations = static_cast<int>(kept.history.size());
+  result.source_points = kept.source_points;
+  result.target_points = kept.target_points;
+  result.history = std::move(kept.history);
+  result.config = config;
+  result.auto_fields = std::move(auto_fields);
+  result.runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+}  // namespace boicp

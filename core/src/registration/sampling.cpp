@@ -1,0 +1,65 @@
+#include "boicp/registration/sampling.hpp"
+
+#include <cstdint>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace boicp {
+namespace {
+
+// Unbiased integer in [0, bound) by rejection: draws below 2^64 mod bound would
+// make the low residues slightly more likely, so they are redrawn.
+uint64_t UniformIndex(uint64_t bound, std::mt19937_64& rng) {
+  const uint64_t threshold = (0 - bound) % bound;
+  for (;;) {
+    const uint64_t r = rng();
+    if (r >= threshold) return r % bound;
+  }
+}
+
+// Fisher-Yates, written out because std::shuffle's sequence is library-specific.
+std::vector<int> RandomPermutation(int n, std::mt19937_64& rng) {
+  std::vector<int> p(static_cast<size_t>(n));
+  std::iota(p.begin(), p.end(), 0);
+  for (int i = n - 1; i > 0; --i) {
+    const auto j = static_cast<int>(UniformIndex(static_cast<uint64_t>(i) + 1, rng));
+    std::swap(p[static_cast<size_t>(i)], p[static_cast<size_t>(j)]);
+  }
+  return p;
+}
+
+void CheckShape(int n, int d, const char* what) {
+  if (n < 0 || d < 0) {
+    throw std::invalid_argument(std::string(what) + ": negative size " + std::to_string(n) + " x " +
+                                std::to_string(d));
+  }
+}
+
+}  // namespace
+
+double UniformUnit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+Eigen::MatrixXd UniformPoints(int n, int d, std::mt19937_64& rng) {
+  CheckShape(n, d, "UniformPoints");
+  Eigen::MatrixXd X(n, d);
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < d; ++k) X(i, k) = UniformUnit(rng);
+  }
+  return X;
+}
+
+Eigen::MatrixXd LatinHypercube(int n, int d, std::mt19937_64& rng) {
+  CheckShape(n, d, "LatinHypercube");
+  Eigen::MatrixXd X(n, d);
+  for (int k = 0; k < d; ++k) {
+    const std::vector<int> slice = RandomPermutation(n, rng);
+    for (int i = 0; i < n; ++i) {
+      X(i, k) = (slice[static_cast<size_t>(i)] + UniformUnit(rng)) / n;
+    }
+  }
+  return X;
+}
+
+}  // namespace boicp
