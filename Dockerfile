@@ -1,7 +1,7 @@
 # boicp image: boicpd (the gRPC map-building daemon) and boicp (the client).
-#   docker build -t boicp:0.1.0 .
+#   docker build -t boicp .
 #   docker run -d --name boicpd -e BOICPD_WORKERS=2 -p 127.0.0.1:50051:50051 \
-#     -v boicpd-data:/var/lib/boicpd boicp:0.1.0
+#     -v boicpd-data:/var/lib/boicpd boicp
 # The build stage uses the same dependency script and configure flags as
 # .ci/run but builds only the two binaries: .ci/run runs the tests on its host
 # build, then runs this image with tests/deploy/test_image.sh. (podman keeps the
@@ -9,6 +9,13 @@
 # The runtime stage holds only the runtime libraries and the two binaries.
 # tests/deploy/check_deploy.py (ctest deploy_*) keeps this file in step with
 # deploy/install-deps.sh, .ci/run and CMake.
+
+# The runtime stage takes the binaries from the `binaries` stage: by default
+# the build stage below; with --build-arg BINARIES=prebuilt, build/bin/boicpd
+# and build/bin/boicp of the build context, which must come from a build on
+# Debian bookworm with deploy/install-deps.sh (tests/deploy/test_image.sh
+# --prebuilt gives it the binaries .ci/run has just built and tested).
+ARG BINARIES=build
 
 FROM debian:bookworm AS build
 WORKDIR /src
@@ -20,6 +27,11 @@ ARG BUILD_JOBS=2
 RUN cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DBOICP_WARNINGS_AS_ERRORS=ON \
  && cmake --build build -j"${BUILD_JOBS}" --target boicpd boicp
 
+FROM scratch AS prebuilt
+COPY build/bin/boicpd build/bin/boicp /src/build/bin/
+
+FROM ${BINARIES} AS binaries
+
 FROM debian:bookworm-slim AS runtime
 ARG VERSION=0.1.0
 LABEL org.opencontainers.image.title="boicp" \
@@ -29,7 +41,7 @@ LABEL org.opencontainers.image.title="boicp" \
       org.opencontainers.image.licenses="NOASSERTION"
 COPY deploy/install-deps.sh /tmp/install-deps.sh
 RUN bash /tmp/install-deps.sh --runtime && rm -rf /var/lib/apt/lists/* /tmp/install-deps.sh
-COPY --from=build /src/build/bin/boicpd /src/build/bin/boicp /usr/local/bin/
+COPY --from=binaries /src/build/bin/boicpd /src/build/bin/boicp /usr/local/bin/
 # A fixed numeric uid so Kubernetes' runAsNonRoot can check it and volumes can be chowned to it.
 RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/boicpd \
       --shell /usr/sbin/nologin boicp \

@@ -1,4 +1,4 @@
-// boicp-bench: BO-ICP against its baselines on reference pairs (issue #3).
+// boicp-bench: BO-ICP against its baselines on reference pairs.
 // Exit codes: 0 done, 2 bad command line or unreadable input.
 
 #include <filesystem>

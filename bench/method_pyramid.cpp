@@ -15,6 +15,7 @@
 #include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/search_space.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "dataset_config.hpp"
 #include "methods.hpp"
 
@@ -53,9 +54,8 @@ class GridScorer {
       : points_(points), target_(target), radius_sq_(radius * radius), threads_(threads) {}
 
   void Score(const SearchSpace& space, std::vector<Candidate>& candidates) {
-    const auto n = static_cast<long>(candidates.size());
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 8) if (threads_ > 1)
-    for (long k = 0; k < n; ++k) {
+    const size_t n = candidates.size();
+    ParallelFor(n, threads_, [&](size_t k) {
       const Transform T = space.ToTransform(candidates[k].u);
       const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
       const Eigen::Vector3d t = T.topRightCorner<3, 1>();
@@ -65,7 +65,7 @@ class GridScorer {
         inliers += target_.Nearest(R * p + t, radius_sq_, index, sq_distance) ? 1 : 0;
       }
       candidates[k].fit = static_cast<double>(inliers) / static_cast<double>(points_.size());
-    }
+    });
     evaluations_ += static_cast<int>(n);
   }
   int evaluations() const { return evaluations_; }

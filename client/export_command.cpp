@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <map>
 
-#include "boicp/util/atomic_file.hpp"
-#include "boicp/mapping/map_preview.hpp"
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/mapping/map_preview.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "remote_options.hpp"

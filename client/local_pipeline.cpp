@@ -11,8 +11,8 @@
 #include <set>
 #include <thread>
 
-#include "boicp/util/atomic_file.hpp"
 #include "boicp/mapping/map_preview.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 #include "json_output.hpp"
 

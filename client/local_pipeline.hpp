@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "boicp/mapping/batch_pair.hpp"
 #include "boicp/io/scan_folder.hpp"
+#include "boicp/mapping/batch_pair.hpp"
 #include "local_pairs.hpp"
 
 namespace boicp::cli {

@@ -3,8 +3,8 @@
 
 #include <iostream>
 
-#include "boicp/mapping/map_preview.hpp"
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/mapping/map_preview.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 

@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/io/point_cloud_io.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"

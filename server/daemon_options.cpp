@@ -2,15 +2,16 @@
 
 #include <algorithm>
 #include <stdexcept>
-#include <thread>
 #include <vector>
+
+#include "boicp/util/parallel_for.hpp"
 
 namespace boicp::server {
 
 void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
   // Every flag also reads BOICPD_<FLAG> (a flag on the command line wins), so
   // containers and systemd units configure the daemon without a wrapper script.
-  o.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  o.workers = AvailableCores();
   app.add_option("--listen", o.listen, "HOST:PORT to serve on (port 0 picks a free port)")
       ->capture_default_str()
       ->envname("BOICPD_LISTEN");

@@ -117,20 +117,50 @@ def check_dockerfile(args):
     env_options = daemon_env_options(args.boicpd)
     known_env = {env for env, _ in env_options.values()}
 
-    stages = [a for _, k, a in instructions if k == "FROM"]
-    if len(stages) != 2 or not all(s.split()[0].startswith("debian:bookworm") for s in stages):
-        problems.append(f"Dockerfile: want two stages FROM debian:bookworm*, got {stages}")
+    stages = stage_names(instructions)
+    debian = [i for i, (base, _) in enumerate(stages) if base.startswith("debian:bookworm")]
+    if len(debian) != 2 or stages[debian[0]][1] != "build" or debian[1] != len(stages) - 1:
+        problems.append(
+            f"Dockerfile: want a build and a last (runtime) stage FROM debian:bookworm*, got {stages}"
+        )
+        return problems
+    build, runtime = debian
+    problems += check_binaries_choice(read(os.path.join(root, "Dockerfile")), stages)
 
     runs = [(stage, a) for stage, k, a in instructions if k == "RUN"]
-    problems += check_apt_and_deps_script(runs, build_packages, runtime_packages)
+    problems += check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_packages)
     problems += check_build_flags(root, runs)
-    problems += check_build_targets(args, runs)
-    problems += check_copied_binaries(args, instructions)
-    problems += check_runtime_stage(instructions, known_env, root)
+    problems += check_build_targets(args, runs, build)
+    problems += check_copied_binaries(args, instructions, stages, runtime)
+    problems += check_runtime_stage(instructions, known_env, root, runtime)
     return problems
 
 
-def check_apt_and_deps_script(runs, build_packages, runtime_packages):
+def stage_names(instructions):
+    """[(base image, stage name)] of each FROM, in order."""
+    stages = []
+    for _, keyword, argument in instructions:
+        if keyword == "FROM":
+            words = argument.split()
+            stages.append((words[0], words[2] if len(words) > 2 and words[1].upper() == "AS" else ""))
+    return stages
+
+
+def check_binaries_choice(text, stages):
+    """The runtime copies from a `binaries` stage that is the build stage unless
+    BINARIES=prebuilt picks the binaries of the build context (a CI's host build)."""
+    problems = []
+    default = re.search(r"^ARG BINARIES=(\S+)", text, re.M)
+    if not default or default.group(1) != "build":
+        problems.append("Dockerfile: want `ARG BINARIES=build` before the first FROM")
+    if ("scratch", "prebuilt") not in stages:
+        problems.append("Dockerfile: want a `FROM scratch AS prebuilt` stage")
+    if ("${BINARIES}", "binaries") not in stages:
+        problems.append("Dockerfile: want a `FROM ${BINARIES} AS binaries` stage")
+    return problems
+
+
+def check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_packages):
     problems, used_deps_script = [], {}
     allowed = set(build_packages) | set(runtime_packages)
     for stage, argument in runs:
@@ -145,9 +175,9 @@ def check_apt_and_deps_script(runs, build_packages, runtime_packages):
                     for p in extra
                     if p not in allowed
                 ]
-    if used_deps_script.get(0) != []:
+    if used_deps_script.get(build) != []:
         problems.append("Dockerfile: the build stage must run deploy/install-deps.sh with no flags")
-    if used_deps_script.get(1) != ["--runtime"]:
+    if used_deps_script.get(runtime) != ["--runtime"]:
         problems.append("Dockerfile: the runtime stage must run deploy/install-deps.sh --runtime")
     return problems
 
@@ -167,7 +197,7 @@ def check_build_flags(root, runs):
     return []
 
 
-def check_build_targets(args, runs):
+def check_build_targets(args, runs, build):
     """The image builds only the two binaries it ships and runs no tests: .ci/run ran them
     on the host build, then runs the image itself (tests/deploy/test_image.sh)."""
     problems, targets = [], None
@@ -176,7 +206,7 @@ def check_build_targets(args, runs):
         for words in shell_commands(argument):
             if words[:1] == ["ctest"]:
                 problems.append("Dockerfile: no ctest in the image (.ci/run tests the host build)")
-            if words[:2] == ["cmake", "--build"] and stage == 0:
+            if words[:2] == ["cmake", "--build"] and stage == build:
                 if "--target" not in words:
                     problems.append(f"Dockerfile: cmake --build must build only --target {wanted}")
                     continue
@@ -189,27 +219,33 @@ def check_build_targets(args, runs):
     return problems
 
 
-def check_copied_binaries(args, instructions):
+def check_copied_binaries(args, instructions, stages, runtime):
+    """The runtime copies exactly the binaries CMake builds, from where CMake puts
+    them, and the prebuilt stage takes the same files from the build context."""
     built = {}
     for path in (args.boicpd, args.boicp):
         built[os.path.basename(path)] = os.path.relpath(path, args.build_dir)
-    copied = {}
+    prebuilt = next(i for i, stage in enumerate(stages) if stage == ("scratch", "prebuilt"))
+    copied, context = {}, {}
     for stage, keyword, argument in instructions:
-        if keyword == "COPY" and "--from=build" in argument:
-            sources = [w for w in argument.split() if not w.startswith("--")][:-1]
-            for source in sources:
-                copied[os.path.basename(source)] = source
+        sources = [w for w in argument.split() if not w.startswith("--")][:-1]
+        if keyword == "COPY" and stage == runtime and "--from=binaries" in argument:
+            copied.update((os.path.basename(source), source) for source in sources)
+        if keyword == "COPY" and stage == prebuilt:
+            context.update((os.path.basename(source), source) for source in sources)
     problems = []
     if set(copied) != set(built):
         problems.append(f"Dockerfile: copies {sorted(copied)}, CMake builds {sorted(built)}")
     for name, source in copied.items():
         if name in built and not source.endswith("/build/" + built[name]):
             problems.append(f"Dockerfile: {source} is not where CMake puts {name} (build/{built[name]})")
+        if context.get(name) != "build/" + built.get(name, ""):
+            problems.append(f"Dockerfile: the prebuilt stage must copy build/{built.get(name)}")
     return problems
 
 
-def check_runtime_stage(instructions, known_env, root):
-    runtime = [(k, a) for stage, k, a in instructions if stage == 1]
+def check_runtime_stage(instructions, known_env, root, runtime_stage):
+    runtime = [(k, a) for stage, k, a in instructions if stage == runtime_stage]
     by_keyword = {}
     for keyword, argument in runtime:
         by_keyword.setdefault(keyword, []).append(argument)

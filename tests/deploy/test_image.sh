@@ -15,15 +15,23 @@
 # The engine is docker when `docker info` works, else podman (set up with
 # ../shared/tools/podman-setup.sh when missing). Containers use host networking
 # with a free loopback port, and are removed on exit, as are the volumes.
-# Usage: tests/deploy/test_image.sh BIN_DIR
+# Usage: tests/deploy/test_image.sh [--prebuilt] BIN_DIR
 #   BIN_DIR      the host build's binaries (boicp is the host client), e.g. build/bin
+#   --prebuilt   the image takes BIN_DIR's boicpd and boicp (--build-arg
+#                BINARIES=prebuilt) instead of compiling them again: for .ci/run,
+#                whose host build on the same Debian release has just been tested
 #   BOICP_SHARED_DIR   default ../shared beside the repository
 #   BOICP_IMAGE_SKIP_COMPOSE=1  skip the compose part
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
-if [ $# -ne 1 ] || [ ! -x "$1/boicp" ]; then
-  echo "usage: $0 BIN_DIR (a folder holding the host build's boicp)" >&2
+prebuilt=""
+if [ "${1:-}" = --prebuilt ]; then
+  prebuilt=1
+  shift
+fi
+if [ $# -ne 1 ] || [ ! -x "$1/boicp" ] || { [ -n "$prebuilt" ] && [ ! -x "$1/boicpd" ]; }; then
+  echo "usage: $0 [--prebuilt] BIN_DIR (a folder holding the host build's boicp, and boicpd with --prebuilt)" >&2
   exit 2
 fi
 bin=$(cd "$1" && pwd)
@@ -96,9 +104,18 @@ log "engine: $engine ($("$engine" --version))"
 build_flags=(-t "$image" -f "$root/Dockerfile")
 # podman's default OCI format drops HEALTHCHECK; the docker format keeps it.
 [ "$engine" = podman ] && build_flags+=(--format docker)
+context=$root
+if [ -n "$prebuilt" ]; then
+  # Only what the prebuilt and runtime stages copy: the compile stage is unused and skipped.
+  context=$tmp/context
+  mkdir -p "$context/deploy" "$context/build/bin"
+  cp "$root/deploy/install-deps.sh" "$context/deploy/"
+  cp "$bin/boicpd" "$bin/boicp" "$context/build/bin/"
+  build_flags+=(--build-arg BINARIES=prebuilt)
+fi
 start=$(date +%s)
-log "building $image (log $tmp/build.log)"
-if ! "$engine" build "${build_flags[@]}" "$root" >"$tmp/build.log" 2>&1; then
+log "building $image${prebuilt:+ from $bin's binaries} (log $tmp/build.log)"
+if ! "$engine" build "${build_flags[@]}" "$context" >"$tmp/build.log" 2>&1; then
   tail -n 40 "$tmp/build.log" >&2
   fail "$engine build"
 fi

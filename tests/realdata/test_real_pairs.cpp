@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/evaluation.hpp"
-#include "boicp/io/point_cloud_io.hpp"
 
 namespace boicp {
 namespace {

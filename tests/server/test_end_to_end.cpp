@@ -12,9 +12,9 @@
 #include <gmock/gmock.h>
 #include <octomap/OcTree.h>
 
-#include "boicp/registration/evaluation.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/registration/evaluation.hpp"
 #include "demo_sequence.hpp"
 #include "server_fixture.hpp"
 

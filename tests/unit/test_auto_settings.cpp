@@ -6,9 +6,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/io/synthetic_scene.hpp"
 
 namespace boicp {
 namespace {

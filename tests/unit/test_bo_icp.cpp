@@ -6,11 +6,11 @@
 #include <limits>
 #include <random>
 
+#include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/evaluation.hpp"
 #include "boicp/registration/icp.hpp"
 #include "boicp/registration/refinement.hpp"
-#include "boicp/io/synthetic_scene.hpp"
 
 namespace boicp {
 namespace {

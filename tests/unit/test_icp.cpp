@@ -2,11 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/alignment_score.hpp"
 #include "boicp/registration/icp.hpp"
 #include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/search_space.hpp"
-#include "boicp/io/synthetic_scene.hpp"
 
 namespace boicp {
 namespace {

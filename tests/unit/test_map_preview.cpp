@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <vector>
 
@@ -152,7 +153,12 @@ TEST(MapPreview, ReadsOccupiedCellsOfBtAndOt) {
   map.WriteFull((dir / "m.ot").string());
   map.WriteBinary((dir / "m.bt").string());
   for (const char* name : {"m.bt", "m.ot"}) {
+    // OctoMap's own readers print "Reading ... octree type"; ours stays quiet.
+    ::testing::internal::CaptureStderr();
+    ::testing::internal::CaptureStdout();
     const OccupiedCells cells = ReadOccupiedCells((dir / name).string());
+    EXPECT_EQ(::testing::internal::GetCapturedStdout(), "") << name;
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << name;
     EXPECT_DOUBLE_EQ(cells.resolution, 0.5) << name;
     ASSERT_FALSE(cells.centres.empty()) << name;
     for (const Point& c : cells.centres) EXPECT_NEAR(c.x(), 4.0, 0.5) << name;
@@ -165,6 +171,14 @@ TEST(MapPreview, ReadsOccupiedCellsOfBtAndOt) {
     EXPECT_THAT(e.what(), HasSubstr("bad.bt: not an OctoMap file"));
   }
   EXPECT_THROW(ReadOccupiedCells((dir / "none.bt").string()), InputError);
+  // A tree cut short after its header is an error, not an empty map.
+  std::string bytes;
+  {
+    std::ifstream in(dir / "m.bt", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  std::ofstream(dir / "cut.bt", std::ios::binary) << bytes.substr(0, bytes.find("data\n") + 7);
+  EXPECT_THROW(ReadOccupiedCells((dir / "cut.bt").string()), InputError);
   fs::remove_all(dir);
 }
 

@@ -11,11 +11,11 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include "boicp/io/scan_folder.hpp"
+#include "boicp/io/synthetic_scene.hpp"
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_preview.hpp"
 #include "boicp/mapping/map_up.hpp"
-#include "boicp/io/scan_folder.hpp"
-#include "boicp/io/synthetic_scene.hpp"
 
 #ifndef BOICP_SHARED_DATA_DIR
 #define BOICP_SHARED_DATA_DIR ""

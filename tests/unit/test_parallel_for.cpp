@@ -1,4 +1,5 @@
-// ParallelFor: every index once, and the same outcome for any thread count.
+// ParallelFor and ParallelForRanges: every index once, and the same outcome
+// for any thread count.
 
 #include <gtest/gtest.h>
 
@@ -35,6 +36,16 @@ TEST_P(ParallelForThreads, RethrowsTheLowestFailingIndexAfterRunningTheRest) {
 
 TEST_P(ParallelForThreads, NothingToDoIsFine) {
   ParallelFor(0, GetParam(), [](size_t) { FAIL() << "no task expected"; });
+}
+
+TEST_P(ParallelForThreads, RangesCoverEveryIndexExactlyOnce) {
+  std::vector<std::atomic<int>> calls(10007);
+  ParallelForRanges(calls.size(), GetParam(), [&](size_t begin, size_t end) {
+    ASSERT_LT(begin, end);
+    for (size_t i = begin; i < end; ++i) ++calls[i];
+  });
+  for (size_t i = 0; i < calls.size(); ++i) ASSERT_EQ(calls[i].load(), 1) << "index " << i;
+  ParallelForRanges(0, GetParam(), [](size_t, size_t) { FAIL() << "no range expected"; });
 }
 
 // 0 counts as one thread; 8 is more threads than tasks in some cases.

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/registration/refinement.hpp"
 #include "boicp/io/synthetic_scene.hpp"
+#include "boicp/registration/refinement.hpp"
 
 namespace boicp {
 namespace {

@@ -3,9 +3,9 @@
 #include <chrono>
 #include <fstream>
 
-#include "boicp/util/atomic_file.hpp"
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/registration/voxel_cloud.hpp"
+#include "boicp/util/atomic_file.hpp"
 
 namespace boicp {
 namespace {

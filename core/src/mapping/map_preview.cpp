@@ -7,14 +7,14 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <memory>
 #include <numeric>
+#include <string>
 
 #include <open3d/geometry/Image.h>
 #include <open3d/io/ImageIO.h>
 
 #include "boicp/util/atomic_file.hpp"
-#include "io/io_readers.hpp"
+#include "mapping/octree_file.hpp"
 
 namespace boicp {
 namespace {
@@ -25,13 +25,6 @@ constexpr Rgb kBackground{24, 24, 28};
 constexpr Rgb kTrajectory{255, 255, 255};
 constexpr Rgb kStart{40, 220, 60};
 constexpr Rgb kEnd{235, 40, 40};
-
-std::string FirstLine(const std::string& path) {
-  std::ifstream in = io_detail::OpenOrThrow(path, std::ios::binary);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
 
 OccupiedCells CollectOccupied(octomap::OcTree& tree) {
   OccupiedCells cells;
@@ -126,19 +119,7 @@ Eigen::Matrix3d ViewRotation(const Eigen::Vector3d& up_in) {
 }  // namespace
 
 OccupiedCells ReadOccupiedCells(const std::string& path) {
-  const std::string header = FirstLine(path);
-  if (header.rfind("# Octomap OcTree binary file", 0) == 0) {
-    octomap::OcTree tree(0.1);
-    if (!tree.readBinary(path)) throw InputError(path + ": cannot read the OctoMap binary tree");
-    return CollectOccupied(tree);
-  }
-  if (header.rfind("# Octomap OcTree file", 0) == 0) {
-    std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(path));
-    auto* occupancy = dynamic_cast<octomap::OcTree*>(tree.get());
-    if (occupancy == nullptr) throw InputError(path + ": not an OctoMap OcTree");
-    return CollectOccupied(*occupancy);
-  }
-  throw InputError(path + ": not an OctoMap file (.bt or .ot)");
+  return CollectOccupied(*ReadOctreeFile(path));
 }
 
 RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,

@@ -9,8 +9,8 @@
 
 #include <nlopt.hpp>
 
-#include "boicp/util/parallel_for.hpp"
 #include "boicp/registration/sampling.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "boicp/util/parallel_for.hpp"
+
 namespace boicp {
 
 AlignmentScore ScoreAlignment(const Points& source, const NearestNeighborIndex& target,
@@ -11,13 +13,13 @@ AlignmentScore ScoreAlignment(const Points& source, const NearestNeighborIndex& 
   const Eigen::Vector3d t = T.topRightCorner<3, 1>();
   const double tau_sq = tau * tau;
   std::vector<double> sq_distance(source.size());
-  const auto n = static_cast<long>(source.size());
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-  for (long i = 0; i < n; ++i) {
-    size_t index = 0;
-    double d2 = 0.0;
-    sq_distance[i] = target.Nearest(R * source[i] + t, tau_sq, index, d2) ? d2 : tau_sq;
-  }
+  ParallelForRanges(source.size(), threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      size_t index = 0;
+      double d2 = 0.0;
+      sq_distance[i] = target.Nearest(R * source[i] + t, tau_sq, index, d2) ? d2 : tau_sq;
+    }
+  });
 
   // Serial sums in index order: identical for every thread count.
   AlignmentScore score;

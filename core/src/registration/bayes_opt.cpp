@@ -7,8 +7,8 @@
 #include <sstream>
 #include <string>
 
-#include "boicp/util/parallel_for.hpp"
 #include "boicp/registration/sampling.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

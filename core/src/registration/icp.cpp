@@ -6,6 +6,8 @@
 
 #include <Eigen/SVD>
 
+#include "boicp/util/parallel_for.hpp"
+
 namespace boicp {
 namespace {
 
@@ -18,23 +20,23 @@ void MatchNearest(const Points& source, const NearestNeighborIndex& target,
                   const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double max_sq_distance,
                   int threads, Points& moved, std::vector<size_t>& match,
                   std::vector<double>& sq_distance) {
-  const auto n = static_cast<long>(source.size());
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-  for (long i = 0; i < n; ++i) {
-    moved[i] = R * source[i] + t;
-    size_t index = 0;
-    double d2 = 0.0;
-    // The previous iteration's match is close after a small step and bounds the search.
-    const bool found = match[i] == kNoMatch
-                           ? target.Nearest(moved[i], max_sq_distance, index, d2)
-                           : target.NearestWithHint(moved[i], match[i], max_sq_distance, index, d2);
-    if (found) {
-      match[i] = index;
-      sq_distance[i] = d2;
-    } else {
-      match[i] = kNoMatch;
+  ParallelForRanges(source.size(), threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      moved[i] = R * source[i] + t;
+      size_t index = 0;
+      double d2 = 0.0;
+      // The previous iteration's match is close after a small step and bounds the search.
+      const bool found = match[i] == kNoMatch ? target.Nearest(moved[i], max_sq_distance, index, d2)
+                                              : target.NearestWithHint(moved[i], match[i],
+                                                                       max_sq_distance, index, d2);
+      if (found) {
+        match[i] = index;
+        sq_distance[i] = d2;
+      } else {
+        match[i] = kNoMatch;
+      }
     }
-  }
+  });
 }
 
 // Mean of every point's distance clipped at tau; unmatched points (beyond the

@@ -1,35 +1,71 @@
 #include "boicp/util/parallel_for.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
-#include <atomic>
 #include <exception>
-#include <thread>
 #include <vector>
 
 namespace boicp {
+namespace {
+
+// Runs `loop` in an arena of `threads` slots, the calling thread among them.
+template <typename Loop>
+void InArena(int threads, const Loop& loop) {
+  tbb::task_arena arena(threads);
+  arena.execute(loop);
+}
+
+}  // namespace
+
+int AvailableCores() { return std::max(1, tbb::info::default_concurrency()); }
 
 void ParallelFor(size_t count, int threads, const std::function<void(size_t)>& task) {
   if (count == 0) return;
   std::vector<std::exception_ptr> errors(count);
-  std::atomic<size_t> next{0};
-  const auto work = [&] {
-    for (size_t i = next++; i < count; i = next++) {
-      try {
-        task(i);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
+  const auto run = [&](size_t i) {
+    try {
+      task(i);
+    } catch (...) {
+      errors[i] = std::current_exception();
     }
   };
-  const size_t helpers = std::min<size_t>(count, static_cast<size_t>(std::max(threads, 1))) - 1;
-  std::vector<std::thread> pool;
-  pool.reserve(helpers);
-  for (size_t k = 0; k < helpers; ++k) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  if (threads <= 1 || count == 1) {
+    for (size_t i = 0; i < count; ++i) run(i);
+  } else {
+    // One index a task: each takes milliseconds, so balance beats batching.
+    InArena(threads, [&] {
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, count, 1),
+          [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i < range.end(); ++i) run(i);
+          },
+          tbb::simple_partitioner());
+    });
+  }
   for (const std::exception_ptr& error : errors) {
     if (error) std::rethrow_exception(error);
   }
+}
+
+void ParallelForRanges(size_t count, int threads,
+                       const std::function<void(size_t begin, size_t end)>& body) {
+  if (count == 0) return;
+  if (threads <= 1) {
+    body(0, count);
+    return;
+  }
+  // One contiguous block a thread: the work per index is even, and a static
+  // split keeps each thread's points (and their cache lines) its own.
+  InArena(threads, [&] {
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, count),
+        [&](const tbb::blocked_range<size_t>& range) { body(range.begin(), range.end()); },
+        tbb::static_partitioner());
+  });
 }
 
 }  // namespace boicp

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "boicp/mapping/map_assembly.hpp"
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/mapping/map_assembly.hpp"
 
 namespace boicp {
 

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "boicp/registration/auto_settings.hpp"
-#include "boicp/registration/bo_icp.hpp"
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/mapping/pose_graph.hpp"
+#include "boicp/registration/auto_settings.hpp"
+#include "boicp/registration/bo_icp.hpp"
 
 namespace boicp {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "boicp/mapping/occupancy_map.hpp"
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/mapping/occupancy_map.hpp"
 #include "boicp/mapping/pose_graph.hpp"
 
 namespace boicp {

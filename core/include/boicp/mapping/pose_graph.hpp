@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "boicp/registration/bo_icp.hpp"
 #include "boicp/mapping/map_pairs.hpp"
+#include "boicp/registration/bo_icp.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "boicp/registration/config.hpp"
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/registration/config.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
