@@ -355,6 +355,9 @@ struct PairingCase {
 // daemon's two workers against the map's one thread also show that the
 // result does not depend on the thread count.
 TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
+  // The overlap plan keeps keyframe 0 on this street (its scans overlap above
+  // 0.7 even when spaced 10 m apart);
+  // MapPipeline.KeyframeChainComesFromTheStoredOverlaps covers keyframe changes.
   const fs::path scans = MakeDrive(5);
   // Explicit: the chain plus one loop closure, so the pose graph is optimised.
   const fs::path pairs_file = dir_ / "pairs.csv";
@@ -404,6 +407,14 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
     const RunResult r = Run("map " + scans.string() + " -o " + out.string() + Quick() +
                             " --pairing " + pairing.cli_flags);
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    if (pairing.name == "overlap") {
+      // Probes run ahead on more threads, yet the keyframes are the same.
+      const fs::path wide = dir_ / "out-overlap-3-threads";
+      const RunResult r3 = Run("map " + scans.string() + " -o " + wide.string() + Quick() +
+                               " --pairing overlap --threads 3");
+      ASSERT_EQ(r3.exit_code, 0) << r3.err;
+      EXPECT_EQ(Slurp(wide / "trajectory.kitti"), Slurp(out / "trajectory.kitti"));
+    }
 
     *request.mutable_pairing() = pairing.pairing;
     const v1::Job job = client.Watch(client.Submit(request).job_id());
