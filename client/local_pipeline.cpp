@@ -1,18 +1,9 @@
 #include "local_pipeline.hpp"
 
-#include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
-#include <set>
-#include <thread>
 
-#include "boicp/mapping/map_preview.hpp"
-#include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 #include "json_output.hpp"
 
@@ -26,23 +17,6 @@ std::string JoinNames(const std::vector<std::string>& names) {
   std::string joined;
   for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
   return joined;
-}
-
-double NowSeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-std::string FormatDuration(double seconds) {
-  const long s = std::lround(std::max(seconds, 0.0));
-  char text[32];
-  if (s >= 3600) {
-    std::snprintf(text, sizeof(text), "%ldh%02ldm", s / 3600, (s / 60) % 60);
-  } else if (s >= 60) {
-    std::snprintf(text, sizeof(text), "%ldm%02lds", s / 60, s % 60);
-  } else {
-    std::snprintf(text, sizeof(text), "%lds", s);
-  }
-  return text;
 }
 
 std::string PairName(const PairIndex& p) {
@@ -248,93 +222,8 @@ json RunManifestJson(const LocalRun& run) {
   return manifest;
 }
 
-PairProgress::PairProgress(int total)
-    : total_(total), started_(NowSeconds()), terminal_(StderrIsTerminal()) {}
-
-void PairProgress::SetTotal(int total) { total_ = total; }
-
-void PairProgress::Done(const PairRecord& record, bool reused) {
-  ++done_;
-  if (!reused) ++registered_;
-  const double elapsed = NowSeconds() - started_;
-  // The rate of pairs registered in this run; reused pairs cost nothing.
-  const std::string eta =
-      registered_ > 0 ? FormatDuration(elapsed / registered_ * std::max(total_ - done_, 0)) : "?";
-  if (terminal_) {
-    constexpr int kWidth = 30;
-    const int filled = total_ > 0 ? kWidth * std::min(done_, total_) / total_ : 0;
-    std::fprintf(stderr, "\r[%s%s] %d/%d pairs  ETA %-8s", std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, '.').c_str(), done_, total_, eta.c_str());
-  } else {
-    std::fprintf(stderr, "pair %s %s (%d/%d): fitness %.3f, confidence %.2f%s, %.1f s, ETA %s\n",
-                 PairName(record.pair).c_str(), reused ? "reused" : "done", done_, total_,
-                 record.fitness, record.confidence, IsDoubtful(record) ? " (doubtful)" : "",
-                 record.runtime_s, eta.c_str());
-  }
-  std::fflush(stderr);
-}
-
-void PairProgress::Finish() {
-  if (terminal_ && done_ > 0) std::fputc('\n', stderr);
-  std::fprintf(stderr, "%d pairs (%d registered, %d reused) in %s\n", done_, registered_,
-               done_ - registered_, FormatDuration(NowSeconds() - started_).c_str());
-}
-
-std::map<PairIndex, PairRecord> RunPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
-                                         const std::string& out_dir, int threads,
-                                         PairProgress& progress, int* reused_count) {
-  if (threads < 1) throw InputError("--threads: must be >= 1");
-  const std::vector<ScanSource>& scans = run.folder.scans;
-  std::mutex mutex;
-  size_t next = 0;
-  std::atomic<bool> stop{false};
-  std::exception_ptr failure;
-  std::map<PairIndex, PairRecord> records;
-  int reused_total = 0;
-  auto work = [&] {
-    for (;;) {
-      PairIndex pair;
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (next >= pairs.size() || stop) return;
-        pair = pairs[next++];
-      }
-      try {
-        json settings = PairSettings(scans, pair, run.config);
-        std::optional<PairRecord> stored;
-        try {
-          stored = ReadPairFile(out_dir, pair);
-        } catch (const InputError&) {
-          stored.reset();  // unreadable: registered again and overwritten
-        }
-        const bool reused = stored && stored->settings == settings;
-        PairRecord record = reused
-                                ? std::move(*stored)
-                                : MakePairRecord(scans, pair,
-                                                 RegisterBatchPair(scans, pair, run.config,
-                                                                   [&stop] { return stop.load(); }),
-                                                 std::move(settings));
-        if (!reused) WritePairFile(out_dir, record);
-        std::lock_guard<std::mutex> lock(mutex);
-        if (reused) ++reused_total;
-        progress.Done(record, reused);
-        records[pair] = std::move(record);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-        return;
-      }
-    }
-  };
-  std::vector<std::thread> workers;
-  const int count = std::min<int>(threads, static_cast<int>(pairs.size()));
-  for (int i = 1; i < count; ++i) workers.emplace_back(work);
-  work();
-  for (std::thread& worker : workers) worker.join();
-  if (failure) std::rethrow_exception(failure);
-  if (reused_count) *reused_count += reused_total;
-  return records;
+PairingPlan RunPlan(const LocalRun& run) {
+  return run.keyframes ? PlanKeyframes(run.overlap_threshold) : PlanFixedPairs(run.plan);
 }
 
 std::map<PairIndex, PairRecord> ReadStoredPairs(const LocalRun& run,
@@ -392,63 +281,6 @@ std::string ManifestDifferences(const MapSettings& a, const MapSettings& b) {
                    (jb.contains(key) ? jb[key].dump() : std::string("(none)"));
   }
   return differences;
-}
-
-MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairRecord>& chain,
-                                 const std::vector<PairRecord>& all, const std::string& out_dir) {
-  std::vector<PairConstraint> constraints;
-  for (const PairRecord& r : chain) constraints.push_back(RecordConstraint(r));
-  const PoseEstimate estimate =
-      EstimatePoses(run.folder.scans, constraints, BatchPoseGraphOptions(run.config));
-
-  const fs::path dir(out_dir);
-  fs::create_directories(dir);
-  MapOutputPaths paths;
-  paths.octomap_bt = (dir / "map.bt").string();
-  paths.octomap_ot = (dir / "map.ot").string();
-  paths.trajectory_tum = (dir / "trajectory.tum").string();
-  paths.trajectory_kitti = (dir / "trajectory.kitti").string();
-  AssemblyCallbacks callbacks;
-  const bool terminal = StderrIsTerminal();
-  callbacks.progress = [terminal](const AssemblyProgress& p) {
-    if (p.stage != "fusing") return;
-    if (terminal) {
-      std::fprintf(stderr, "\rfusing %d/%d scans", p.done, p.total);
-      if (p.done == p.total) std::fputc('\n', stderr);
-    } else if (p.done == p.total) {
-      std::fprintf(stderr, "fused %d scans\n", p.total);
-    }
-  };
-  const FusionSummary fusion =
-      FuseScans(run.folder.scans, estimate.poses, run.map, paths, callbacks);
-  UpDetectionOptions up_options;
-  if (!run.folder.scans.empty()) up_options.sensor_up = SensorUp(run.folder.scans[0].load.format);
-  const UpDirection up = WriteMapPreview(paths.octomap_bt, estimate.poses,
-                                         (dir / "preview.png").string(), {}, up_options);
-  std::fprintf(stderr, "preview: %s\n", up.reason.c_str());
-
-  std::set<PairIndex> in_graph;
-  for (size_t i = 0; i < chain.size(); ++i) {
-    if (estimate.kept[i]) in_graph.insert(chain[i].pair);
-  }
-  json listing = json::array();
-  for (const PairRecord& r : all) {
-    json entry = PairRecordToJson(r);
-    entry["in_graph"] = in_graph.count(r.pair) > 0;
-    listing.push_back(std::move(entry));
-  }
-  WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
-  const int doubtful = static_cast<int>(
-      std::count_if(all.begin(), all.end(), [](const PairRecord& r) { return IsDoubtful(r); }));
-
-  MapOutputSummary summary;
-  summary.poses = estimate.poses;
-  summary.optimised = estimate.optimised;
-  summary.occupied_leaves = fusion.occupied_leaves;
-  summary.fusion_s = fusion.seconds;
-  summary.pairs_doubtful = doubtful;
-  summary.pairs_listed = static_cast<int>(all.size());
-  return summary;
 }
 
 }  // namespace boicp::cli

@@ -1,8 +1,7 @@
 #pragma once
-// The one-shot local map pipeline behind `boicp map` and `boicp merge`:
-// the run's settings (as flags and as the run.json manifest), the scan
-// folder, the pairs, running them with per-pair result files, and the
-// outputs. Registration and assembly are core's, the daemon's own code.
+// The settings of the one-shot local map runs behind `boicp map` and
+// `boicp merge`: as flags and as the run.json manifest, the scan folder and
+// the pairs. Running them is core's map pipeline (local_map.hpp).
 
 #include <cstdint>
 #include <functional>
@@ -79,32 +78,6 @@ nlohmann::json RunManifestJson(const LocalRun& run);
 /// "source,target" header skipped). Throws InputError naming file and line.
 std::vector<PairIndex> ReadPairsFile(const std::string& path);
 
-/// Progress of the registration stage on stderr: a redrawn bar on a
-/// terminal, one line per pair otherwise.
-class PairProgress {
- public:
-  explicit PairProgress(int total);
-  void SetTotal(int total);
-  /// A pair finished (reused: its file was already there).
-  void Done(const PairRecord& record, bool reused);
-  void Finish();
-
- private:
-  int total_;
-  int done_ = 0, registered_ = 0;
-  double started_;
-  double registering_s_ = 0.0;
-  bool terminal_;
-};
-
-/// Runs `pairs` on `threads` workers (one registration thread each). A pair
-/// whose file in OUTDIR/pairs holds the same settings is reused, not
-/// redone; every new result is written to its file as soon as it finishes.
-/// Throws the first failure (after the running pairs stop).
-std::map<PairIndex, PairRecord> RunPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
-                                         const std::string& out_dir, int threads,
-                                         PairProgress& progress, int* reused = nullptr);
-
 /// The stored results of `pairs`, each from the first of `dirs` whose
 /// pairs/ holds it, checked against the run's settings. Throws InputError
 /// naming the missing pairs or the first file with other settings.
@@ -123,19 +96,8 @@ MapSettings ReadRunManifest(const std::string& dir);
 /// config: A vs C"); empty when they agree.
 std::string ManifestDifferences(const MapSettings& a, const MapSettings& b);
 
-struct MapOutputSummary {
-  std::vector<Transform> poses;  // T_map_scan
-  bool optimised = false;
-  size_t occupied_leaves = 0;
-  double fusion_s = 0.0;
-  int pairs_listed = 0;    // `all`
-  int pairs_doubtful = 0;  // of which doubtful
-};
-
-/// From the chain's records (constraint order) to OUTDIR/map.bt, map.ot,
-/// trajectory.tum, trajectory.kitti, pairs.json (every record in `all`,
-/// with in_graph) and preview.png.
-MapOutputSummary WriteMapOutputs(const LocalRun& run, const std::vector<PairRecord>& chain,
-                                 const std::vector<PairRecord>& all, const std::string& out_dir);
+/// The run's pairing plan for core's map pipeline: run.plan chained, or
+/// keyframes by overlap.
+PairingPlan RunPlan(const LocalRun& run);
 
 }  // namespace boicp::cli

@@ -1,5 +1,5 @@
 // `boicp map`: a scan folder to an OctoMap and a trajectory in one process,
-// no daemon, with the daemon's own pair registration and map assembly.
+// no daemon, through core's map pipeline as the daemon runs it.
 
 #include <chrono>
 #include <cstdio>
@@ -9,7 +9,7 @@
 
 #include "boicp/util/atomic_file.hpp"
 #include "commands.hpp"
-#include "local_pipeline.hpp"
+#include "local_map.hpp"
 #include "map_settings_flags.hpp"
 
 namespace boicp::cli {
@@ -28,27 +28,6 @@ struct MapFlags {
 
 std::string Absolute(const std::string& path) {
   return path.empty() ? path : fs::absolute(path).lexically_normal().string();
-}
-
-// Overlap pairing: each scan onto the current keyframe, decided by the
-// registrations' overlap estimates, in rounds of `threads` probes.
-std::map<PairIndex, PairRecord> RunKeyframes(const LocalRun& run, const std::string& out_dir,
-                                             int threads, PairProgress& progress, int* reused,
-                                             std::vector<PairIndex>* chain) {
-  const int n = static_cast<int>(run.folder.scans.size());
-  KeyframePlanner planner(n, run.overlap_threshold);
-  std::map<PairIndex, PairRecord> all;
-  while (!planner.Done()) {
-    const std::vector<PairIndex> probes = planner.NextProbes(threads);
-    if (probes.empty()) throw std::runtime_error("the keyframe plan stalled");
-    for (auto& [pair, record] : RunPairs(run, probes, out_dir, threads, progress, reused)) {
-      planner.Record(pair, PlannerOverlap(record));
-      all[pair] = std::move(record);
-    }
-    progress.SetTotal(static_cast<int>(all.size()) + n - planner.AttachedScans());
-  }
-  *chain = planner.ChainPairs();
-  return all;
 }
 
 struct Shard {
@@ -96,10 +75,7 @@ int RunShard(const LocalRun& run, const Shard& shard, const MapFlags& flags) {
   }
   std::fprintf(stderr, "shard %d/%d: %zu of %zu pairs\n", shard.index, shard.count, mine.size(),
                run.plan.size());
-  int reused = 0;
-  PairProgress progress(static_cast<int>(mine.size()));
-  RunPairs(run, mine, out, flags.threads, progress, &reused);
-  progress.Finish();
+  const int reused = RegisterLocalPairs(run, mine, out, flags.threads);
   std::fprintf(stderr, "shard %d/%d done; when every shard is, run: boicp merge %s -o OUTDIR\n",
                shard.index, shard.count, out.c_str());
   if (flags.json) {
@@ -121,32 +97,12 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
   fs::create_directories(out);
   WriteTextFileAtomically(RunManifestPath(out), RunManifestJson(run).dump(1) + "\n");
 
-  int reused = 0;
-  std::vector<PairIndex> chain_pairs = run.plan;
-  std::map<PairIndex, PairRecord> records;
-  PairProgress progress(run.keyframes ? static_cast<int>(run.folder.scans.size()) - 1
-                                      : static_cast<int>(run.plan.size()));
-  if (run.keyframes) {
-    records = RunKeyframes(run, out, flags.threads, progress, &reused, &chain_pairs);
-  } else {
-    records = RunPairs(run, run.plan, out, flags.threads, progress, &reused);
-  }
-  progress.Finish();
-
-  std::vector<PairRecord> chain, all;
-  for (const PairIndex& p : chain_pairs) chain.push_back(records.at(p));
-  if (run.keyframes) {
-    for (const auto& entry : records) all.push_back(entry.second);
-  } else {
-    all = chain;
-  }
-  const MapOutputSummary summary = WriteMapOutputs(run, chain, all, out);
+  const MapOutputSummary summary = BuildLocalMap(run, out, flags.threads);
   std::fprintf(stderr,
                "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
                "preview.png}: %zu occupied leaves\n",
                out.c_str(), summary.occupied_leaves);
-  std::fprintf(stderr, "%s\n",
-               DoubtfulSummary(summary.pairs_doubtful, summary.pairs_listed).c_str());
+  std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
   if (flags.json) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -157,8 +113,8 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
     }
     std::cout << json{{"layout", ScanLayoutName(run.folder.layout)},
                       {"scans", run.folder.scans.size()},
-                      {"pairs", records.size()},
-                      {"pairs_reused", reused},
+                      {"pairs", summary.pairs},
+                      {"pairs_reused", summary.pairs_reused},
                       {"pairs_doubtful", summary.pairs_doubtful},
                       {"pose_graph_optimised", summary.optimised},
                       {"occupied_leaves", summary.occupied_leaves},

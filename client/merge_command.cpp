@@ -8,7 +8,7 @@
 
 #include "boicp/util/atomic_file.hpp"
 #include "commands.hpp"
-#include "local_pipeline.hpp"
+#include "local_map.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -49,17 +49,14 @@ int RunMerge(const MergeFlags& flags) {
     std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(),
                  run.folder.description.c_str(), records.size());
     PrintRunSettings(run);
-    std::vector<PairRecord> chain;
-    for (const PairIndex& p : run.plan) chain.push_back(records.at(p));
     fs::create_directories(flags.out_dir);
     WriteTextFileAtomically(RunManifestPath(flags.out_dir), RunManifestJson(run).dump(1) + "\n");
-    const MapOutputSummary summary = WriteMapOutputs(run, chain, chain, flags.out_dir);
+    const MapOutputSummary summary = AssembleStoredPairs(run, records, flags.out_dir);
     std::fprintf(stderr,
                  "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
                  "preview.png}: %zu occupied leaves\n",
                  flags.out_dir.c_str(), summary.occupied_leaves);
-    std::fprintf(stderr, "%s\n",
-                 DoubtfulSummary(summary.pairs_doubtful, summary.pairs_listed).c_str());
+    std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
     if (flags.json) {
       std::cout << json{{"scans", run.folder.scans.size()},
                         {"pairs", records.size()},

@@ -14,12 +14,12 @@
 #include <thread>
 #include <vector>
 
+#include "boicp/util/thread_pool.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
 #include "job_events.hpp"
 #include "job_runner.hpp"
 #include "job_store.hpp"
-#include "thread_pool.hpp"
 
 namespace boicp::server {
 

@@ -2,35 +2,24 @@
 
 #include <algorithm>
 #include <chrono>
-#include <deque>
-#include <filesystem>
-#include <map>
 #include <optional>
 #include <set>
 
 #include <spdlog/spdlog.h>
 
 #include "boicp/mapping/batch_pair.hpp"
-#include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/map_pipeline.hpp"
 #include "job_outputs.hpp"
+#include "job_pair_store.hpp"
 #include "job_spec.hpp"
-#include "pair_task.hpp"
 #include "proto_convert.hpp"
 #include "scan_integrity.hpp"
 
 namespace boicp::server {
 
-void JobControl::Cancel() {
-  std::lock_guard<std::mutex> lock(mutex);
-  cancelled_ = true;
-  changed.notify_all();
-}
+void JobControl::Cancel() { cancelled_ = true; }
 
-void JobControl::Interrupt() {
-  std::lock_guard<std::mutex> lock(mutex);
-  interrupted_ = true;
-  changed.notify_all();
-}
+void JobControl::Interrupt() { interrupted_ = true; }
 
 namespace {
 
@@ -39,56 +28,61 @@ using Clock = std::chrono::steady_clock;
 
 constexpr auto kProgressInterval = std::chrono::seconds(1);
 
-PairIndex IndexOf(const v1::PairResult& result) {
-  return {static_cast<int>(result.source()), static_cast<int>(result.target())};
+std::string PairName(const PairIndex& p) {
+  return std::to_string(p.source) + "->" + std::to_string(p.target);
 }
 
-// The keyframe planner's overlap estimate; results stored before overlap
-// was computed fall back to their fitness.
-double PlannerOverlap(const v1::PairResult& result) {
-  return result.has_overlap() ? result.overlap() : result.fitness();
+const char* PairingName(PairingMode pairing) {
+  switch (pairing) {
+    case PairingMode::kConsecutive:
+      return "consecutive";
+    case PairingMode::kKeyframes:
+      return "keyframe";
+    case PairingMode::kExplicit:
+      return "explicit";
+  }
+  return "unknown";
 }
 
-// The pose-graph weight of a stored pair; results stored before confidence
-// was calibrated (no doubtful mark) are trusted, as they were then.
-double EdgeConfidence(const v1::PairResult& result) {
-  return result.has_doubtful() ? result.confidence() : 1.0;
+PairingPlan JobPlan(const JobSpec& spec) {
+  if (spec.pairing == PairingMode::kKeyframes) {
+    return PlanKeyframes(spec.overlap_threshold, spec.extra_pairs);
+  }
+  return PlanFixedPairs(spec.base_pairs, spec.extra_pairs);
 }
 
-std::pair<int, int> Unordered(const PairIndex& p) {
-  return {std::min(p.source, p.target), std::max(p.source, p.target)};
-}
-
-// What a pair task hands back to the runner thread.
-struct Completion {
-  PairIndex pair;
-  std::optional<StoredPair> stored;  // set on success
-  bool stopped = false;              // Cancelled by a stop request
-  std::string error;                 // set on failure
-};
-
-class JobRun {
+// One run of a job: core's map pipeline with the job's rows in the job store
+// as its pair store, and this class as its progress sink (the job record,
+// persisted and published to watchers). What stays here is the job's
+// lifetime: its state, its ETA, and how it ends.
+class JobRun : public MapProgressSink {
  public:
   JobRun(const RunnerContext& context, JobControl& control, v1::Job job)
       : ctx_(context), control_(control), job_(std::move(job)) {}
-  // Pair tasks refer to this run and to `control_`, which the caller frees
-  // once the run returns.
-  ~JobRun() { StopTasks(); }
   JobRun(const JobRun&) = delete;
   JobRun& operator=(const JobRun&) = delete;
 
   RunOutcome Run() {
     try {
       Prepare();
-      if (!RegisterPairs()) return EndAfterStop();
-      if (!failure_.empty()) return End(v1::JOB_STATE_FAILED, failure_);
-      return Assemble();
+      JobPairStore pairs(ctx_.store, batch_spec_);
+      pairs_ = &pairs;
+      PairExecution execution;
+      execution.submit = [this](std::function<void()> task) { ctx_.pool.Submit(std::move(task)); };
+      execution.max_in_flight = ctx_.max_pairs_in_flight;
+      execution.stop_requested = [this] { return control_.StopRequested(); };
+      // Returns only once none of the job's pair tasks runs: no pair is
+      // stored after the job's final state, whatever was thrown.
+      const MapPipelineResult result = RunMapPipeline(
+          batch_, pairs, *this, execution, JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id())));
+      pairs_ = nullptr;
+      return Finish(result);
     } catch (const Cancelled&) {
-      StopTasks();
+      pairs_ = nullptr;
       return EndAfterStop();
     } catch (const std::exception& e) {
-      StopTasks();  // no pair may be stored after the job's final state
-      return End(v1::JOB_STATE_FAILED, e.what());
+      pairs_ = nullptr;
+      return End(v1::JOB_STATE_FAILED, failure_.empty() ? e.what() : failure_);
     }
   }
 
@@ -97,233 +91,106 @@ class JobRun {
   void Prepare() {
     const std::optional<JobInput> input = ctx_.store.GetJobInput(job_.job_id());
     if (!input) throw std::runtime_error("the job's input is missing from the data store");
-    spec_ = BuildJobSpec(job_.job_id(), input->request, input->scans, ctx_.data_dir,
-                         ctx_.registration_threads);
-    num_scans_ = static_cast<int>(spec_.scans.size());
+    batch_spec_ = BuildJobSpec(job_.job_id(), input->request, input->scans, ctx_.data_dir,
+                               ctx_.registration_threads);
     VerifyScans();
     // Chosen once from the job's scans; a resumed job chooses the same again.
-    const std::vector<std::string> auto_fields =
-        ApplyBatchSettings(spec_.scans, spec_.config, spec_.map.occupancy, spec_.map_auto);
-    *job_.mutable_settings() = ChosenSettingsToProto(spec_.config, spec_.map, auto_fields);
-    for (StoredPair& stored : ctx_.store.GetPairs(job_.job_id())) {
-      results_[IndexOf(stored.result)] = std::move(stored);
-    }
-    if (spec_.pairing == PairingMode::kKeyframes) {
-      planner_.emplace(num_scans_, spec_.overlap_threshold);
-      for (const auto& [pair, stored] : results_) {
-        planner_->Record(pair, PlannerOverlap(stored.result));
-        probed_sources_.insert(pair.source);
-      }
-    } else {
-      fixed_plan_ = spec_.base_pairs;
-      fixed_plan_.insert(fixed_plan_.end(), spec_.extra_pairs.begin(), spec_.extra_pairs.end());
-      for (const PairIndex& pair : fixed_plan_) {
-        if (results_.count(pair) == 0) queue_.push_back(pair);
-      }
-    }
-    for (const PairIndex& pair : spec_.extra_pairs) {
-      if (spec_.pairing == PairingMode::kKeyframes && results_.count(pair) == 0) {
-        extras_queue_.push_back(pair);
-      }
-    }
-    // Listing order: a fixed plan's own order; keyframe pairs in launch order.
-    for (size_t i = 0; i < fixed_plan_.size(); ++i) {
-      plan_order_[fixed_plan_[i]] = static_cast<int>(i);
-    }
-    next_order_ = static_cast<int>(results_.size());
-
-    const int resumed = static_cast<int>(results_.size());
+    const std::vector<std::string> auto_fields = ApplyBatchSettings(
+        batch_spec_.scans, batch_spec_.config, batch_spec_.map.occupancy, batch_spec_.map_auto);
+    *job_.mutable_settings() =
+        ChosenSettingsToProto(batch_spec_.config, batch_spec_.map, auto_fields);
+    batch_.scans = batch_spec_.scans;
+    batch_.config = batch_spec_.config;
+    batch_.map = batch_spec_.map;
+    batch_.plan = JobPlan(batch_spec_);
     job_.set_state(v1::JOB_STATE_RUNNING);
     if (job_.started_at() == 0.0) job_.set_started_at(NowSeconds());
     job_.set_stage("registering");
     job_.set_eta_seconds(-1.0);
-    UpdateCounts();
-    Persist();
-    Publish(nullptr);
-    spdlog::info("job {} running: {} scans, {} pairing, preset {}, {} of {} pairs already done",
-                 job_.job_id(), num_scans_, PairingName(), spec_.config.preset, resumed,
-                 job_.pairs_total());
   }
 
   // A scan whose bytes no longer match its name fails the job (the error
   // names it) rather than feeding a wrong cloud into the map.
   void VerifyScans() const {
-    const std::set<std::string> unique(spec_.scan_ids.begin(), spec_.scan_ids.end());
+    const std::set<std::string> unique(batch_spec_.scan_ids.begin(), batch_spec_.scan_ids.end());
     for (const std::string& scan_id : unique) VerifyStoredScan(ctx_.data_dir, scan_id);
   }
 
-  std::string PairingName() const {
-    switch (spec_.pairing) {
-      case PairingMode::kConsecutive:
-        return "consecutive";
-      case PairingMode::kKeyframes:
-        return "keyframe";
-      case PairingMode::kExplicit:
-        return "explicit";
-    }
-    return "unknown";
-  }
-
-  // Asks the running pair tasks to stop and waits until none is left.
-  void StopTasks() {
-    aborting_ = true;
-    std::unique_lock<std::mutex> lock(control_.mutex);
-    control_.changed.wait(lock, [this] { return in_flight_ == 0; });
-  }
-
-  // ---- Registration stage ------------------------------------------------
-  // Returns false when a stop request ended it.
-  bool RegisterPairs() {
+  // ---- Progress (MapProgressSink) ------------------------------------------
+  void RegistrationStarted(const PairCounts& counts) override {
     run_start_ = Clock::now();
-    last_progress_ = run_start_;
-    std::unique_lock<std::mutex> lock(control_.mutex);
-    bool stop_seen = false;
-    for (;;) {
-      if (!control_.StopRequested() && failure_.empty()) {
-        lock.unlock();
-        LaunchAvailable();
-        lock.lock();
-      }
-      // A pair may have finished while the previous batch was absorbed: its
-      // completion waits in completions_ and must be absorbed before the end.
-      if (in_flight_ == 0 && completions_.empty() &&
-          (PlanComplete() || control_.StopRequested() || !failure_.empty())) {
-        break;
-      }
-      control_.changed.wait_for(lock, kProgressInterval, [&] {
-        return !completions_.empty() || (control_.StopRequested() && !stop_seen);
-      });
-      if (control_.StopRequested() && !stop_seen) {
-        stop_seen = true;
-        job_.set_cancel_requested(control_.cancelled());
-      }
-      std::deque<Completion> batch;
-      batch.swap(completions_);
-      lock.unlock();
-      for (Completion& completion : batch) Absorb(std::move(completion));
-      MaybePublishProgress();
-      lock.lock();
-    }
-    return !control_.StopRequested();
+    SetCounts(counts);
+    Persist();
+    Publish(nullptr);
+    spdlog::info("job {} running: {} scans, {} pairing, preset {}, {} of {} pairs already done",
+                 job_.job_id(), batch_.scans.size(), PairingName(batch_spec_.pairing),
+                 batch_.config.preset, counts.done, counts.total);
   }
 
-  bool PlanComplete() const {
-    if (planner_) return planner_->Done() && extras_queue_.empty();
-    return queue_.empty();
-  }
-
-  // Hands pairs to the pool until the job's share of it is used. A fixed plan
-  // keeps one more pair waiting in the pool, so a worker that finishes a pair
-  // starts the next at once instead of idling while this thread stores the
-  // last one. Keyframe probes wait: the next probe depends on the results.
-  void LaunchAvailable() {
-    const int limit = ctx_.max_pairs_in_flight + (planner_ ? 0 : 1);
-    for (;;) {
-      {
-        std::lock_guard<std::mutex> lock(control_.mutex);
-        if (in_flight_ >= limit) return;
-      }
-      const std::optional<PairIndex> next = NextPair();
-      if (!next) return;
-      Launch(*next);
-    }
-  }
-
-  std::optional<PairIndex> NextPair() {
-    if (!planner_) {
-      if (queue_.empty()) return std::nullopt;
-      const PairIndex pair = queue_.front();
-      queue_.pop_front();
-      return pair;
-    }
-    for (const PairIndex& probe : planner_->NextProbes(1)) {
-      if (results_.count(probe) != 0 || launched_.count(probe) != 0) continue;
-      probed_sources_.insert(probe.source);
-      return probe;
-    }
-    if (!extras_queue_.empty()) {
-      const PairIndex pair = extras_queue_.front();
-      extras_queue_.pop_front();
-      return pair;
-    }
-    return std::nullopt;
-  }
-
-  void Launch(const PairIndex& pair) {
-    launched_.insert(pair);
-    const auto planned = plan_order_.find(pair);
-    const int order = planned != plan_order_.end() ? planned->second : next_order_++;
-    {
-      std::lock_guard<std::mutex> lock(control_.mutex);
-      ++in_flight_;
-    }
-    // The runner waits for every launched task before it returns, so the
-    // task may refer to it.
-    ctx_.pool.Submit([this, pair, order, job_id = job_.job_id()] {
-      Completion completion;
-      completion.pair = pair;
-      if (control_.StopRequested() || aborting_) {
-        completion.stopped = true;
-      } else {
-        try {
-          PairOutcome outcome = RegisterJobPair(
-              spec_, pair, [this] { return control_.StopRequested() || aborting_; });
-          ctx_.store.PutPair(job_id, order, outcome.result, outcome.information);
-          completion.stored = StoredPair{std::move(outcome.result), outcome.information};
-        } catch (const Cancelled&) {
-          completion.stopped = true;
-        } catch (const std::exception& e) {
-          completion.error = e.what();
-        }
-      }
-      std::lock_guard<std::mutex> lock(control_.mutex);
-      --in_flight_;
-      completions_.push_back(std::move(completion));
-      control_.changed.notify_all();
-    });
-  }
-
-  void Absorb(Completion completion) {
-    launched_.erase(completion.pair);
-    const std::string name =
-        std::to_string(completion.pair.source) + "->" + std::to_string(completion.pair.target);
-    if (!completion.error.empty()) {
-      spdlog::error("job {} pair {} failed: {}", job_.job_id(), name, completion.error);
-      if (failure_.empty()) failure_ = "pair " + name + ": " + completion.error;
-      aborting_ = true;  // the job fails: the other pairs need not finish
-      return;
-    }
-    if (!completion.stored) return;
-    const v1::PairResult& r = completion.stored->result;
-    results_[completion.pair] = *completion.stored;
+  void PairFinished(const FinishedPair& pair, bool reused, const PairCounts& counts) override {
+    if (reused) return;  // counted by RegistrationStarted
     ++done_this_run_;
     last_done_ = Clock::now();
-    if (planner_) planner_->Record(completion.pair, PlannerOverlap(r));
-    UpdateCounts();
+    SetCounts(counts);
     Persist();
+    const std::optional<v1::PairResult> r = pairs_->Result(pair.pair);
+    if (!r) throw std::logic_error("a finished pair is missing from the job's pair store");
     spdlog::info(
         "job {} pair {} done in {:.2f} s ({}/{}): fitness {:.3f}, confidence {:.3f}{}, "
         "objective {:.4f} m",
-        job_.job_id(), name, r.runtime_s(), job_.pairs_done(), job_.pairs_total(), r.fitness(),
-        r.confidence(), r.doubtful() ? " (doubtful)" : "", r.objective());
-    Publish(&r);
+        job_.job_id(), PairName(pair.pair), r->runtime_s(), job_.pairs_done(), job_.pairs_total(),
+        r->fitness(), r->confidence(), r->doubtful() ? " (doubtful)" : "", r->objective());
+    Publish(&*r);
   }
 
-  void UpdateCounts() {
-    job_.set_pairs_done(static_cast<uint32_t>(results_.size()));
-    job_.set_pairs_doubtful(static_cast<uint32_t>(
-        std::count_if(results_.begin(), results_.end(),
-                      [](const auto& entry) { return entry.second.result.doubtful(); })));
-    if (planner_) {
-      // Keyframe plans grow as they go: what ran or runs, plus one probe per
-      // scan not probed yet.
-      const int unprobed = std::max(0, num_scans_ - 1 - static_cast<int>(probed_sources_.size()));
-      job_.set_pairs_total(
-          static_cast<uint32_t>(results_.size() + launched_.size() + extras_queue_.size()) +
-          static_cast<uint32_t>(unprobed));
-    } else {
-      job_.set_pairs_total(static_cast<uint32_t>(fixed_plan_.size()));
+  void PairFailed(const PairIndex& pair, const std::string& message) override {
+    spdlog::error("job {} pair {} failed: {}", job_.job_id(), PairName(pair), message);
+    failure_ = "pair " + PairName(pair) + ": " + message;
+  }
+
+  void Heartbeat() override { MaybePublishProgress(); }
+
+  void PosesEstimated(const PoseEstimate& estimate,
+                      const std::vector<PairIndex>& in_graph) override {
+    job_.set_pose_graph_optimised(estimate.optimised);
+    if (estimate.optimised) {
+      spdlog::info("job {} pose graph optimised: {} loop closures, {} of {} edges kept",
+                   job_.job_id(), estimate.loop_closures, in_graph.size(), estimate.kept.size());
     }
+  }
+
+  void StageStarted(const std::string& stage, int total) override {
+    if (stage == "fusing") {
+      const std::string dir = ctx_.data_dir.CreateJobDir(job_.job_id());
+      RemoveStagingFiles(dir);
+    }
+    SetStage(stage, 0, static_cast<uint32_t>(total));
+    if (stage == "fusing") {
+      VerifyScans();  // fusion reads every scan again; the registrations took a while
+      fuse_start_ = Clock::now();
+    }
+  }
+
+  void AssemblyStep(const AssemblyProgress& p) override {
+    const bool new_stage = p.stage != job_.stage();
+    if (new_stage) job_.set_stage(p.stage);
+    job_.set_stage_done(static_cast<uint32_t>(p.done));
+    job_.set_stage_total(static_cast<uint32_t>(p.total));
+    if (p.stage == "fusing" && p.done > 0) {
+      const double elapsed = std::chrono::duration<double>(Clock::now() - fuse_start_).count();
+      job_.set_eta_seconds(elapsed / p.done * (p.total - p.done));
+    }
+    if (new_stage) {
+      Publish(nullptr);  // watchers see "writing" begin, not a second later
+    } else {
+      MaybePublishProgress();
+    }
+  }
+
+  void SetCounts(const PairCounts& counts) {
+    job_.set_pairs_done(static_cast<uint32_t>(counts.done));
+    job_.set_pairs_doubtful(static_cast<uint32_t>(counts.doubtful));
+    job_.set_pairs_total(static_cast<uint32_t>(counts.total));
     job_.set_stage_done(job_.pairs_done());
     job_.set_stage_total(job_.pairs_total());
     UpdateEta();
@@ -347,84 +214,6 @@ class JobRun {
     Publish(nullptr);
   }
 
-  // ---- Assembly ----------------------------------------------------------
-  RunOutcome Assemble() {
-    std::vector<PairIndex> chain =
-        planner_ ? planner_->ChainPairs() : std::vector<PairIndex>(spec_.base_pairs);
-    std::set<std::pair<int, int>> in_chain;
-    for (const PairIndex& p : chain) in_chain.insert(Unordered(p));
-    std::vector<PairConstraint> constraints;
-    std::vector<PairIndex> used;
-    auto add = [&](const PairIndex& p) {
-      const StoredPair& stored = results_.at(p);
-      constraints.push_back({p, TransformFromProto(stored.result.transform(), "stored pair"),
-                             stored.information, EdgeConfidence(stored.result)});
-      used.push_back(p);
-    };
-    for (const PairIndex& p : chain) add(p);
-    // Loop closures; a keyframe chain may already hold the same two scans.
-    for (const PairIndex& p : spec_.extra_pairs) {
-      if (in_chain.count(Unordered(p)) == 0) add(p);
-    }
-
-    const bool loops = static_cast<int>(constraints.size()) > num_scans_ - 1;
-    SetStage(loops ? "optimising" : "chaining", 0, 1);
-    const PoseEstimate estimate =
-        EstimatePoses(spec_.scans, constraints, BatchPoseGraphOptions(spec_.config));
-    std::vector<PairIndex> kept;
-    for (size_t i = 0; i < used.size(); ++i) {
-      if (estimate.kept[i]) kept.push_back(used[i]);
-    }
-    ctx_.store.MarkPairsInGraph(job_.job_id(), kept);
-    job_.set_pose_graph_optimised(estimate.optimised);
-    if (estimate.optimised) {
-      spdlog::info("job {} pose graph optimised: {} loop closures, {} of {} edges kept",
-                   job_.job_id(), estimate.loop_closures, kept.size(), used.size());
-    }
-
-    const std::string dir = ctx_.data_dir.CreateJobDir(job_.job_id());
-    RemoveStagingFiles(dir);
-    SetStage("fusing", 0, static_cast<uint32_t>(num_scans_));
-    VerifyScans();  // fusion reads every scan again; the registrations took a while
-    const auto fuse_start = Clock::now();
-    AssemblyCallbacks callbacks;
-    callbacks.stop_requested = [this] { return control_.StopRequested(); };
-    callbacks.progress = [this, fuse_start](const AssemblyProgress& p) {
-      const bool new_stage = p.stage != job_.stage();
-      if (new_stage) job_.set_stage(p.stage);
-      job_.set_stage_done(static_cast<uint32_t>(p.done));
-      job_.set_stage_total(static_cast<uint32_t>(p.total));
-      if (p.stage == "fusing" && p.done > 0) {
-        const double elapsed = std::chrono::duration<double>(Clock::now() - fuse_start).count();
-        job_.set_eta_seconds(elapsed / p.done * (p.total - p.done));
-      }
-      if (new_stage) {
-        Publish(nullptr);  // watchers see "writing" begin, not a second later
-      } else {
-        MaybePublishProgress();
-      }
-    };
-    const FusionSummary summary =
-        FuseScans(spec_.scans, estimate.poses, spec_.map, JobOutputPaths(dir), callbacks);
-    RequireOutputsWritten(JobOutputPaths(dir));
-    spdlog::info("job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points",
-                 job_.job_id(), num_scans_, summary.seconds, summary.occupied_leaves,
-                 summary.cloud_points);
-
-    std::vector<v1::TrajectoryPose> trajectory;
-    const std::vector<double> stamps = ScanTimestamps(spec_.scans);
-    for (int i = 0; i < num_scans_; ++i) {
-      v1::TrajectoryPose pose;
-      pose.set_index(static_cast<uint32_t>(i));
-      pose.set_scan_id(spec_.scan_ids[static_cast<size_t>(i)]);
-      TransformToProto(estimate.poses[static_cast<size_t>(i)], pose.mutable_pose());
-      pose.set_timestamp(stamps[static_cast<size_t>(i)]);
-      trajectory.push_back(std::move(pose));
-    }
-    ctx_.store.PutTrajectory(job_.job_id(), trajectory);
-    return End(v1::JOB_STATE_SUCCEEDED, "");
-  }
-
   void SetStage(const std::string& stage, uint32_t done, uint32_t total) {
     job_.set_stage(stage);
     job_.set_stage_done(done);
@@ -435,6 +224,27 @@ class JobRun {
   }
 
   // ---- Endings -------------------------------------------------------------
+  RunOutcome Finish(const MapPipelineResult& result) {
+    const MapOutputPaths outputs = JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id()));
+    RequireOutputsWritten(outputs);
+    const AssembledMap& map = result.map;
+    spdlog::info("job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points",
+                 job_.job_id(), batch_.scans.size(), map.fusion.seconds, map.fusion.occupied_leaves,
+                 map.fusion.cloud_points);
+    std::vector<v1::TrajectoryPose> trajectory;
+    const std::vector<double> stamps = ScanTimestamps(batch_.scans);
+    for (size_t i = 0; i < batch_.scans.size(); ++i) {
+      v1::TrajectoryPose pose;
+      pose.set_index(static_cast<uint32_t>(i));
+      pose.set_scan_id(batch_spec_.scan_ids[i]);
+      TransformToProto(map.estimate.poses[i], pose.mutable_pose());
+      pose.set_timestamp(stamps[i]);
+      trajectory.push_back(std::move(pose));
+    }
+    ctx_.store.PutTrajectory(job_.job_id(), trajectory);
+    return End(v1::JOB_STATE_SUCCEEDED, "");
+  }
+
   RunOutcome EndAfterStop() {
     if (control_.cancelled()) return End(v1::JOB_STATE_CANCELLED, "");
     spdlog::info("job {} interrupted by shutdown after {} of {} pairs; it resumes on restart",
@@ -479,6 +289,7 @@ class JobRun {
   }
 
   void Publish(const v1::PairResult* pair) {
+    if (control_.cancelled()) job_.set_cancel_requested(true);
     v1::JobEvent event;
     *event.mutable_job() = job_;
     if (pair) *event.mutable_pair() = *pair;
@@ -489,26 +300,15 @@ class JobRun {
   const RunnerContext& ctx_;
   JobControl& control_;
   v1::Job job_;
-  JobSpec spec_;
-  int num_scans_ = 0;
-  std::map<PairIndex, StoredPair> results_;
-  std::optional<KeyframePlanner> planner_;
-  std::vector<PairIndex> fixed_plan_;
-  std::deque<PairIndex> queue_;
-  std::deque<PairIndex> extras_queue_;
-  std::set<PairIndex> launched_;
-  std::set<int> probed_sources_;
-  std::map<PairIndex, int> plan_order_;
-  int next_order_ = 0;
-  std::atomic<bool> aborting_{false};
+  JobSpec batch_spec_;
+  MapBatch batch_;
+  JobPairStore* pairs_ = nullptr;  // during the pipeline only
+  std::string failure_;            // the first failed pair, named
   int done_this_run_ = 0;
-  std::string failure_;
   Clock::time_point run_start_;
   Clock::time_point last_progress_;
   Clock::time_point last_done_;  // when this run last finished a pair
-  // Guarded by control_.mutex.
-  int in_flight_ = 0;
-  std::deque<Completion> completions_;
+  Clock::time_point fuse_start_;
 };
 
 }  // namespace

@@ -1,18 +1,17 @@
 #pragma once
-// Runs one job: its pair registrations on the shared pool (skipping pairs a
-// previous run of the daemon finished), then map assembly on the calling
-// thread. Every finished pair is stored before it is reported, so a daemon
-// killed at any point resumes with only the unfinished pairs.
+// Runs one job through core's map pipeline: its pair registrations on the
+// shared pool (skipping pairs a previous run of the daemon finished), then
+// map assembly on the calling thread. Every finished pair is stored before
+// it is reported, so a daemon killed at any point resumes with only the
+// unfinished pairs.
 
 #include <atomic>
-#include <condition_variable>
-#include <mutex>
 
+#include "boicp/util/thread_pool.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
 #include "job_events.hpp"
 #include "job_store.hpp"
-#include "thread_pool.hpp"
 
 namespace boicp::server {
 
@@ -26,7 +25,8 @@ struct RunnerContext {
 };
 
 /// Stop requests for a running job, shared by the manager, the runner and
-/// the job's pair tasks (which poll it between ICP evaluations).
+/// the job's pair tasks (which poll it between ICP evaluations; the pipeline
+/// polls it between pairs, so a stop takes effect within one evaluation).
 class JobControl {
  public:
   /// The user cancelled: the job ends CANCELLED.
@@ -36,9 +36,6 @@ class JobControl {
   bool cancelled() const { return cancelled_; }
   bool interrupted() const { return interrupted_; }
   bool StopRequested() const { return cancelled_ || interrupted_; }
-
-  std::mutex mutex;                 // guards the runner's completion queue
-  std::condition_variable changed;  // a pair finished or a stop was requested
 
  private:
   std::atomic<bool> cancelled_{false};

@@ -1,7 +1,7 @@
 // `boicp map` and `boicp preview` as a script sees them: every output file,
 // reruns that reuse finished pairs, one-line errors with exit code 2, the
 // real KITTI folder, and the same trajectory as the daemon for the same
-// seed, config and pairing.
+// seed, config and pairing (consecutive, overlap and explicit).
 
 #include <octomap/OcTree.h>
 #include <sys/wait.h>
@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -339,30 +340,57 @@ TEST_F(MapCli, SevenScenesWithNoFlagsFollowsTheReferencePoses) {
 }
 
 #ifdef BOICP_TEST_WITH_DAEMON
+namespace v1 = ::boicp::v1;
+
+// One pairing as `boicp map` and the daemon spell it.
+struct PairingCase {
+  std::string name;
+  std::string cli_flags;  // after --pairing
+  v1::PairingPolicy pairing;
+};
+
 // The daemon path (upload + submit, same seed, config and pairing) gives the
-// same pairs and trajectory as `boicp map`: both run core's RegisterBatchPair
-// and EstimatePoses.
-TEST_F(MapCli, SameTrajectoryAsTheDaemon) {
-  const fs::path scans = MakeDrive(4);
-  const fs::path out = dir_ / "out";
-  const RunResult r = Run("map " + scans.string() + " -o " + out.string() + Quick());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+// same pairs and trajectory as `boicp map` for each pairing: both run core's
+// map pipeline, which decides the pairs and assembles the poses, and the
+// daemon's two workers against the map's one thread also show that the
+// result does not depend on the thread count.
+TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
+  // The overlap plan keeps keyframe 0 on this street (its scans overlap above
+  // 0.7 even when spaced 10 m apart);
+  // MapPipeline.KeyframeChainComesFromTheStoredOverlaps covers keyframe changes.
+  const fs::path scans = MakeDrive(5);
+  // Explicit: the chain plus one loop closure, so the pose graph is optimised.
+  const fs::path pairs_file = dir_ / "pairs.csv";
+  std::ofstream(pairs_file) << "source,target\n0,1\n1,2\n2,3\n3,4\n4,2\n";
+  std::vector<PairingCase> cases(3);
+  cases[0].name = "consecutive";
+  cases[0].cli_flags = "consecutive";
+  cases[0].pairing.set_mode(v1::PairingPolicy::MODE_CONSECUTIVE);
+  cases[1].name = "overlap";
+  cases[1].cli_flags = "overlap";
+  cases[1].pairing.set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  cases[2].name = "explicit";
+  cases[2].cli_flags = "explicit " + pairs_file.string();
+  cases[2].pairing.set_mode(v1::PairingPolicy::MODE_EXPLICIT);
+  for (const auto& [source, target] :
+       std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 2}}) {
+    v1::Pair* pair = cases[2].pairing.add_pairs();
+    pair->set_source(static_cast<uint32_t>(source));
+    pair->set_target(static_cast<uint32_t>(target));
+  }
 
   test::DaemonProcess daemon(
       {"--data-dir", (dir_ / "daemon").string(), "--workers", "2", "--registration-threads", "1"},
       (dir_ / "daemon.log").string());
   client::MapBuilderClient client(client::Connect({daemon.address(), "", "", "", "", 4 << 20}));
-  namespace v1 = ::boicp::v1;
   v1::SubmitBatchRequest request;
-  for (const Transform& pose : truth_) {
-    (void)pose;
+  for (size_t i = 0; i < truth_.size(); ++i) {
     char name[32];
-    std::snprintf(name, sizeof(name), "scan%03d.xyz", request.scan_ids_size());
+    std::snprintf(name, sizeof(name), "scan%03zu.xyz", i);
     v1::ScanMetadata metadata;
     metadata.set_format(v1::SCAN_FORMAT_XYZ);
     request.add_scan_ids(client.UploadFile((scans / name).string(), metadata).scan_id());
   }
-  request.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_CONSECUTIVE);
   v1::RegistrationConfig& config = *request.mutable_config();
   config.set_preset("A");
   config.set_random_samples(4);
@@ -372,27 +400,59 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemon) {
   config.mutable_rotation_bounds()->set_y(0.2);
   config.mutable_rotation_bounds()->set_z(3.14159);
   request.mutable_map()->set_resolution(0.3);
-  const v1::Job job = client.Watch(client.Submit(request).job_id());
-  ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error() << "\n" << daemon.Log();
-  const v1::JobResults results = client.Results(job.job_id());
 
-  const json pairs = json::parse(Slurp(out / "pairs.json"));
-  ASSERT_EQ(results.pairs_size(), 3);
-  for (const v1::PairResult& remote : results.pairs()) {
-    const json& local = pairs.at(remote.source());
-    EXPECT_EQ(local["target"], remote.target());
-    EXPECT_EQ(local["seed"].get<uint64_t>(), remote.seed());
-    for (int k = 0; k < 16; ++k) {
-      EXPECT_NEAR(local["transform"][k / 4][k % 4].get<double>(), remote.transform().m(k), 1e-12)
-          << "pair " << remote.source() << " element " << k;
+  for (const PairingCase& pairing : cases) {
+    SCOPED_TRACE(pairing.name);
+    const fs::path out = dir_ / ("out-" + pairing.name);
+    const RunResult r = Run("map " + scans.string() + " -o " + out.string() + Quick() +
+                            " --pairing " + pairing.cli_flags);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    if (pairing.name == "overlap") {
+      // Probes run ahead on more threads, yet the keyframes are the same.
+      const fs::path wide = dir_ / "out-overlap-3-threads";
+      const RunResult r3 = Run("map " + scans.string() + " -o " + wide.string() + Quick() +
+                               " --pairing overlap --threads 3");
+      ASSERT_EQ(r3.exit_code, 0) << r3.err;
+      EXPECT_EQ(Slurp(wide / "trajectory.kitti"), Slurp(out / "trajectory.kitti"));
     }
-  }
-  const std::vector<Transform> local = ReadKittiTrajectory((out / "trajectory.kitti").string());
-  ASSERT_EQ(results.trajectory_size(), 4);
-  for (const v1::TrajectoryPose& pose : results.trajectory()) {
-    for (int k = 0; k < 12; ++k) {  // the KITTI file keeps 12 significant digits
-      EXPECT_NEAR(local.at(pose.index())(k / 4, k % 4), pose.pose().m(k), 1e-9)
-          << "scan " << pose.index() << " element " << k;
+
+    *request.mutable_pairing() = pairing.pairing;
+    const v1::Job job = client.Watch(client.Submit(request).job_id());
+    ASSERT_EQ(job.state(), v1::JOB_STATE_SUCCEEDED) << job.error() << "\n" << daemon.Log();
+    const v1::JobResults results = client.Results(job.job_id());
+
+    // Every pair both registered has the same seed and transform; the pairs
+    // the poses use are the same ones.
+    std::map<std::pair<int, int>, json> local_pairs;
+    std::set<std::pair<int, int>> local_in_graph, remote_in_graph;
+    for (const json& p : json::parse(Slurp(out / "pairs.json"))) {
+      const std::pair<int, int> key{p["source"].get<int>(), p["target"].get<int>()};
+      local_pairs[key] = p;
+      if (p["in_graph"].get<bool>()) local_in_graph.insert(key);
+    }
+    for (const v1::PairResult& remote : results.pairs()) {
+      const std::pair<int, int> key{static_cast<int>(remote.source()),
+                                    static_cast<int>(remote.target())};
+      if (remote.in_graph()) remote_in_graph.insert(key);
+      const auto local = local_pairs.find(key);
+      if (local == local_pairs.end()) continue;  // a keyframe probe only one side ran ahead to
+      EXPECT_EQ(local->second["seed"].get<uint64_t>(), remote.seed());
+      for (int k = 0; k < 16; ++k) {
+        EXPECT_NEAR(local->second["transform"][k / 4][k % 4].get<double>(), remote.transform().m(k),
+                    1e-12)
+            << "pair " << key.first << "->" << key.second << " element " << k;
+      }
+    }
+    EXPECT_EQ(local_in_graph, remote_in_graph);
+    EXPECT_GE(local_in_graph.size(), truth_.size() - 1);
+
+    const std::vector<Transform> local = ReadKittiTrajectory((out / "trajectory.kitti").string());
+    ASSERT_EQ(results.trajectory_size(), static_cast<int>(truth_.size()));
+    for (const v1::TrajectoryPose& pose : results.trajectory()) {
+      for (int k = 0; k < 12; ++k) {  // the KITTI file keeps 12 significant digits
+        EXPECT_NEAR(local.at(pose.index())(k / 4, k % 4), pose.pose().m(k), 1e-9)
+            << "scan " << pose.index() << " element " << k;
+      }
     }
   }
 }

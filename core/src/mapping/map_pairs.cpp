@@ -4,6 +4,7 @@
 #include <numeric>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "boicp/util/types.hpp"
 
@@ -62,6 +63,21 @@ void ValidatePairs(int num_scans, const std::vector<PairIndex>& pairs, bool requ
                        " to scan 0; every scan needs a chain of pairs to the others");
     }
   }
+}
+
+PairingPlan PlanFixedPairs(std::vector<PairIndex> chain, std::vector<PairIndex> extras) {
+  PairingPlan plan;
+  plan.chain = std::move(chain);
+  plan.extras = std::move(extras);
+  return plan;
+}
+
+PairingPlan PlanKeyframes(double overlap_threshold, std::vector<PairIndex> extras) {
+  PairingPlan plan;
+  plan.keyframes = true;
+  plan.overlap_threshold = overlap_threshold;
+  plan.extras = std::move(extras);
+  return plan;
 }
 
 uint64_t PairSeed(uint64_t job_seed, const PairIndex& pair) {

@@ -34,6 +34,24 @@ std::vector<PairIndex> ConsecutivePairs(int num_scans);
 /// connect every scan, naming a scan that no chain of pairs reaches from scan 0.
 void ValidatePairs(int num_scans, const std::vector<PairIndex>& pairs, bool require_connected);
 
+/// Which pairs a batch registers, decided once for the daemon and `boicp
+/// map` alike. A fixed plan registers `chain` and `extras`, all known up
+/// front; a keyframe plan (PlanKeyframes) grows its chain from the
+/// registrations' overlap estimates (KeyframePlanner) and registers
+/// `extras` besides.
+struct PairingPlan {
+  bool keyframes = false;
+  double overlap_threshold = 0.7;  // keyframes only, in (0, 1]
+  std::vector<PairIndex> chain;    // fixed plans: chained first into poses
+  std::vector<PairIndex> extras;   // loop closures on top of the chain
+};
+
+/// A fixed plan: `chain` (consecutive or explicit pairs) plus `extras`.
+PairingPlan PlanFixedPairs(std::vector<PairIndex> chain, std::vector<PairIndex> extras = {});
+
+/// A keyframe plan with the given overlap threshold, plus `extras`.
+PairingPlan PlanKeyframes(double overlap_threshold, std::vector<PairIndex> extras = {});
+
 /// The search seed of one pair: a SplitMix64 mix of the job seed and the two
 /// indices. It depends on nothing else, so a batch that is resumed or
 /// scheduled differently gives every pair the same result.

@@ -1,8 +1,8 @@
-#include "thread_pool.hpp"
+#include "boicp/util/thread_pool.hpp"
 
 #include <algorithm>
 
-namespace boicp::server {
+namespace boicp {
 
 ThreadPool::ThreadPool(int threads, std::function<void()> on_thread_start)
     : on_thread_start_(std::move(on_thread_start)) {
@@ -41,4 +41,4 @@ void ThreadPool::Work() {
   }
 }
 
-}  // namespace boicp::server
+}  // namespace boicp

@@ -1,18 +1,13 @@
-#include "pair_task.hpp"
+#include "pair_result_proto.hpp"
 
-#include "boicp/mapping/batch_pair.hpp"
 #include "proto_convert.hpp"
 
 namespace boicp::server {
 
-PairOutcome RegisterJobPair(const JobSpec& spec, const PairIndex& pair,
-                            const std::function<bool()>& stop_requested) {
-  // The gRPC-free part is core's, shared with `boicp map`.
-  const BatchPairResult batch = RegisterBatchPair(spec.scans, pair, spec.config, stop_requested);
+::boicp::v1::PairResult PairResultToProto(const JobSpec& spec, const PairIndex& pair,
+                                          const BatchPairResult& batch) {
   const RegistrationResult& r = batch.registration;
-  PairOutcome outcome;
-  outcome.information = batch.information;
-  ::boicp::v1::PairResult& out = outcome.result;
+  ::boicp::v1::PairResult out;
   out.set_source(static_cast<uint32_t>(pair.source));
   out.set_target(static_cast<uint32_t>(pair.target));
   out.set_source_scan_id(spec.scan_ids.at(static_cast<size_t>(pair.source)));
@@ -29,7 +24,19 @@ PairOutcome RegisterJobPair(const JobSpec& spec, const PairIndex& pair,
   out.set_finished_at(NowSeconds());
   out.set_seed(batch.seed);
   out.set_in_graph(true);
-  return outcome;
+  return out;
+}
+
+FinishedPair FinishedFromProto(const ::boicp::v1::PairResult& result,
+                               const InformationMatrix& information) {
+  FinishedPair finished;
+  finished.pair = {static_cast<int>(result.source()), static_cast<int>(result.target())};
+  finished.transform = TransformFromProto(result.transform(), "stored pair");
+  finished.information = information;
+  finished.confidence = result.has_doubtful() ? result.confidence() : 1.0;
+  finished.planner_overlap = result.has_overlap() ? result.overlap() : result.fitness();
+  finished.doubtful = result.doubtful();
+  return finished;
 }
 
 }  // namespace boicp::server

@@ -1,7 +1,8 @@
 #pragma once
-// A fixed set of worker threads running tasks in FIFO order. Pair
-// registrations of every job share it, so its size is the daemon's
-// --workers setting and nothing else creates registration threads.
+// A fixed set of worker threads running tasks in FIFO order: where the map
+// pipeline's pair registrations run. The daemon has one for all its jobs
+// (its size is --workers, so nothing else creates registration threads);
+// `boicp map` has one of --threads workers.
 
 #include <condition_variable>
 #include <deque>
@@ -10,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-namespace boicp::server {
+namespace boicp {
 
 class ThreadPool {
  public:
@@ -36,4 +37,4 @@ class ThreadPool {
   std::vector<std::thread> workers_;
 };
 
-}  // namespace boicp::server
+}  // namespace boicp

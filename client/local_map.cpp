@@ -1,0 +1,145 @@
+#include "local_map.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "boicp/mapping/map_pipeline.hpp"
+#include "boicp/mapping/map_preview.hpp"
+#include "boicp/util/atomic_file.hpp"
+#include "boicp/util/thread_pool.hpp"
+#include "pair_file_store.hpp"
+#include "terminal_progress.hpp"
+
+namespace boicp::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+MapBatch RunBatch(const LocalRun& run, PairingPlan plan) {
+  MapBatch batch;
+  batch.scans = run.folder.scans;
+  batch.config = run.config;
+  batch.map = run.map;
+  batch.plan = std::move(plan);
+  return batch;
+}
+
+MapOutputPaths LocalOutputPaths(const std::string& out_dir) {
+  const fs::path dir(out_dir);
+  MapOutputPaths paths;
+  paths.octomap_bt = (dir / "map.bt").string();
+  paths.octomap_ot = (dir / "map.ot").string();
+  paths.trajectory_tum = (dir / "trajectory.tum").string();
+  paths.trajectory_kitti = (dir / "trajectory.kitti").string();
+  return paths;
+}
+
+// The pairs pairs.json lists: a fixed plan's, in plan order; for keyframes
+// every probe, in index order.
+std::vector<PairIndex> ListedPairs(const PairingPlan& plan, const RegisteredPairs& registered) {
+  if (!plan.keyframes) {
+    std::vector<PairIndex> listed = plan.chain;
+    listed.insert(listed.end(), plan.extras.begin(), plan.extras.end());
+    return listed;
+  }
+  std::vector<PairIndex> listed;
+  for (const auto& entry : registered.finished) listed.push_back(entry.first);
+  return listed;
+}
+
+// preview.png and pairs.json of an assembled map.
+MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap& map,
+                                        const std::vector<PairRecord>& listed,
+                                        const std::string& out_dir) {
+  const fs::path dir(out_dir);
+  UpDetectionOptions up_options;
+  if (!run.folder.scans.empty()) up_options.sensor_up = SensorUp(run.folder.scans[0].load.format);
+  const UpDirection up = WriteMapPreview(LocalOutputPaths(out_dir).octomap_bt, map.estimate.poses,
+                                         (dir / "preview.png").string(), {}, up_options);
+  std::fprintf(stderr, "preview: %s\n", up.reason.c_str());
+
+  const std::set<PairIndex> in_graph(map.in_graph.begin(), map.in_graph.end());
+  json listing = json::array();
+  for (const PairRecord& r : listed) {
+    json entry = PairRecordToJson(r);
+    entry["in_graph"] = in_graph.count(r.pair) > 0;
+    listing.push_back(std::move(entry));
+  }
+  WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
+
+  MapOutputSummary summary;
+  summary.poses = map.estimate.poses;
+  summary.optimised = map.estimate.optimised;
+  summary.occupied_leaves = map.fusion.occupied_leaves;
+  summary.fusion_s = map.fusion.seconds;
+  summary.pairs = static_cast<int>(listed.size());
+  summary.pairs_doubtful = static_cast<int>(std::count_if(
+      listed.begin(), listed.end(), [](const PairRecord& r) { return IsDoubtful(r); }));
+  return summary;
+}
+
+// Parallelism is across pairs, one registration thread each (config.threads
+// is 1), as the daemon's default --registration-threads.
+PairExecution LocalExecution(ThreadPool& pool) {
+  PairExecution execution;
+  execution.submit = [&pool](std::function<void()> task) { pool.Submit(std::move(task)); };
+  execution.max_in_flight = pool.size();
+  return execution;
+}
+
+}  // namespace
+
+MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads) {
+  const MapBatch batch = RunBatch(run, RunPlan(run));
+  PairFileStore store(batch.scans, batch.config, out_dir);
+  TerminalProgress progress(store);
+  fs::create_directories(out_dir);
+  MapPipelineResult result;
+  {
+    ThreadPool pool(threads);
+    result =
+        RunMapPipeline(batch, store, progress, LocalExecution(pool), LocalOutputPaths(out_dir));
+  }
+  std::vector<PairRecord> listed;
+  for (const PairIndex& pair : ListedPairs(batch.plan, result.pairs)) {
+    listed.push_back(store.Record(pair));
+  }
+  MapOutputSummary summary = WriteListingAndPreview(run, result.map, listed, out_dir);
+  summary.pairs_reused = progress.reused();
+  return summary;
+}
+
+int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
+                       const std::string& out_dir, int threads) {
+  const MapBatch batch = RunBatch(run, PlanFixedPairs(pairs));
+  PairFileStore store(batch.scans, batch.config, out_dir);
+  TerminalProgress progress(store);
+  ThreadPool pool(threads);
+  RegisterPlannedPairs(batch.scans, batch.config, batch.plan, store, progress,
+                       LocalExecution(pool));
+  progress.FinishPairs();
+  return progress.reused();
+}
+
+MapOutputSummary AssembleStoredPairs(const LocalRun& run,
+                                     const std::map<PairIndex, PairRecord>& records,
+                                     const std::string& out_dir) {
+  const MapBatch batch = RunBatch(run, RunPlan(run));
+  RegisteredPairs registered;
+  for (const auto& [pair, record] : records) registered.finished[pair] = FinishedFromRecord(record);
+  registered.chain = batch.plan.chain;
+  PairFileStore store(batch.scans, batch.config, out_dir);
+  TerminalProgress progress(store);
+  fs::create_directories(out_dir);
+  const AssembledMap map =
+      AssembleMap(batch, registered, store, progress, LocalOutputPaths(out_dir));
+  std::vector<PairRecord> listed;
+  for (const PairIndex& pair : ListedPairs(batch.plan, registered))
+    listed.push_back(records.at(pair));
+  return WriteListingAndPreview(run, map, listed, out_dir);
+}
+
+}  // namespace boicp::cli

@@ -1,0 +1,41 @@
+#pragma once
+// Local map runs through core's map pipeline: pair results in
+// OUTDIR/pairs (PairFileStore), progress on stderr (TerminalProgress),
+// pairs on a pool of --threads workers with one registration thread each.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "local_pipeline.hpp"
+
+namespace boicp::cli {
+
+struct MapOutputSummary {
+  std::vector<Transform> poses;  // T_map_scan
+  bool optimised = false;
+  size_t occupied_leaves = 0;
+  double fusion_s = 0.0;
+  int pairs = 0;           // listed in pairs.json
+  int pairs_doubtful = 0;  // of which doubtful
+  int pairs_reused = 0;    // taken from OUTDIR/pairs instead of registered
+};
+
+/// The whole run into OUTDIR: every pair (reusing files with the run's
+/// settings), then map.bt, map.ot, trajectory.tum, trajectory.kitti,
+/// pairs.json and preview.png. Throws the first failure.
+/// Precondition: ChooseRunSettings(run) was called; threads >= 1.
+MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads);
+
+/// A shard's share: registers `pairs` into OUTDIR/pairs (reusing files with
+/// the run's settings), no map. Returns how many were reused.
+int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
+                       const std::string& out_dir, int threads);
+
+/// `boicp merge`: the map from records already read (ReadStoredPairs, one
+/// per pair of run.plan), written to OUTDIR as BuildLocalMap does.
+MapOutputSummary AssembleStoredPairs(const LocalRun& run,
+                                     const std::map<PairIndex, PairRecord>& records,
+                                     const std::string& out_dir);
+
+}  // namespace boicp::cli

@@ -1,0 +1,80 @@
+#include "pair_file_store.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <utility>
+
+namespace boicp::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// "000003-000004.json" -> {3, 4}; nullopt for any other name (staging files included).
+std::optional<PairIndex> PairOfFileName(const std::string& name) {
+  int source = -1, target = -1;
+  char rest[8] = {};
+  if (std::sscanf(name.c_str(), "%6d-%6d.%5s", &source, &target, rest) != 3 ||
+      std::string(rest) != "json" || name.size() != 18) {
+    return std::nullopt;
+  }
+  return PairIndex{source, target};
+}
+
+}  // namespace
+
+FinishedPair FinishedFromRecord(const PairRecord& record) {
+  const PairConstraint edge = RecordConstraint(record);
+  FinishedPair finished;
+  finished.pair = record.pair;
+  finished.transform = edge.T_target_source;
+  finished.information = edge.information;
+  finished.confidence = edge.confidence;
+  finished.planner_overlap = PlannerOverlap(record);
+  finished.doubtful = IsDoubtful(record);
+  return finished;
+}
+
+PairFileStore::PairFileStore(const std::vector<ScanSource>& scans, const BoIcpConfig& config,
+                             std::string out_dir)
+    : scans_(scans), config_(config), out_dir_(std::move(out_dir)) {}
+
+std::vector<FinishedPair> PairFileStore::LoadFinished() {
+  std::vector<FinishedPair> finished;
+  const fs::path dir = fs::path(out_dir_) / "pairs";
+  std::error_code error;
+  if (!fs::is_directory(dir, error)) return finished;
+  const int n = static_cast<int>(scans_.size());
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    const std::optional<PairIndex> pair = PairOfFileName(entry.path().filename().string());
+    if (!pair || pair->source >= n || pair->target >= n || pair->source == pair->target) continue;
+    std::optional<PairRecord> record;
+    try {
+      record = ReadPairFile(out_dir_, *pair);
+    } catch (const InputError&) {
+      continue;  // unreadable: registered again and overwritten
+    }
+    if (!record || record->settings != PairSettings(scans_, *pair, config_)) continue;
+    finished.push_back(FinishedFromRecord(*record));
+    records_[*pair] = std::move(*record);
+  }
+  return finished;
+}
+
+void PairFileStore::Save(const PairIndex& pair, int /*listing_order*/,
+                         const BatchPairResult& result) {
+  PairRecord record = MakePairRecord(scans_, pair, result, PairSettings(scans_, pair, config_));
+  WritePairFile(out_dir_, record);
+  std::lock_guard<std::mutex> lock(mutex_);
+  records_[pair] = std::move(record);
+}
+
+// pairs.json carries in_graph; the pair files themselves do not.
+void PairFileStore::MarkInGraph(const std::vector<PairIndex>& /*in_graph*/) {}
+
+PairRecord PairFileStore::Record(const PairIndex& pair) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return records_.at(pair);
+}
+
+}  // namespace boicp::cli

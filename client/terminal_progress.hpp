@@ -1,0 +1,50 @@
+#pragma once
+// Progress of a local map run on stderr: a redrawn bar on a terminal, one
+// line per pair otherwise, then the fusion stage.
+
+#include "boicp/mapping/map_progress.hpp"
+#include "pair_file_store.hpp"
+
+namespace boicp::cli {
+
+/// The registration stage's counter and ETA.
+class PairProgress {
+ public:
+  explicit PairProgress(int total);
+  void SetTotal(int total);
+  /// A pair finished (reused: its file was already there).
+  void Done(const PairRecord& record, bool reused);
+  void Finish();
+  int reused() const { return done_ - registered_; }
+
+ private:
+  int total_;
+  int done_ = 0, registered_ = 0;
+  double started_;
+  double registering_s_ = 0.0;
+  bool terminal_;
+};
+
+/// The map pipeline's progress sink for `boicp map`, `--shard` and `merge`.
+class TerminalProgress : public MapProgressSink {
+ public:
+  /// `store` (for each pair's figures) must outlive this.
+  explicit TerminalProgress(const PairFileStore& store) : store_(store), pairs_(0) {}
+
+  void PairFinished(const FinishedPair& pair, bool reused, const PairCounts& counts) override;
+  void StageStarted(const std::string& stage, int total) override;
+  void AssemblyStep(const AssemblyProgress& progress) override;
+
+  /// Prints the registration summary line, once.
+  void FinishPairs();
+  int reused() const { return pairs_.reused(); }
+
+ private:
+  const PairFileStore& store_;
+  PairProgress pairs_;
+  bool reported_ = false;  // a pair was reported
+  bool pairs_finished_ = false;
+  bool terminal_ = false;
+};
+
+}  // namespace boicp::cli

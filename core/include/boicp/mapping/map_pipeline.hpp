@@ -1,0 +1,64 @@
+#pragma once
+// The map pipeline of a scan batch, one for the daemon and `boicp map`:
+// plan -> register pairs (RegisterPlannedPairs) -> poses (EstimatePoses) ->
+// fusion and output files (FuseScans). Callers supply where finished pairs
+// are stored (PairStore), where progress goes (MapProgressSink) and the
+// threads pairs run on (PairExecution); nothing else differs.
+
+#include <functional>
+#include <vector>
+
+#include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/pair_scheduler.hpp"
+
+namespace boicp {
+
+/// A batch ready to run: scans, its final settings and its pairing plan.
+struct MapBatch {
+  std::vector<ScanSource> scans;
+  BoIcpConfig config;  // settings chosen (ApplyBatchSettings); config.seed is the batch seed
+  MapBuildSettings map;
+  PairingPlan plan;
+};
+
+/// The pose-graph edges of a batch, in the order EstimatePoses wants them:
+/// the chain, then the plan's extras that do not pair the same two scans as
+/// a chain pair. `pairs[i]` is the pair of `constraints[i]`.
+struct GraphEdges {
+  std::vector<PairConstraint> constraints;
+  std::vector<PairIndex> pairs;
+};
+
+/// Preconditions: `registered.finished` holds every pair of
+/// registered.chain and plan.extras.
+GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& registered);
+
+/// The edges the final poses use (PoseEstimate::kept), in edge order.
+std::vector<PairIndex> PairsInGraph(const GraphEdges& edges, const PoseEstimate& estimate);
+
+struct AssembledMap {
+  PoseEstimate estimate;            // poses are T_map_scan
+  std::vector<PairIndex> in_graph;  // the pairs the poses use
+  FusionSummary fusion;
+};
+
+/// Poses from the registered pairs, then fusion into `outputs`. Reports the
+/// stages to `progress`, marks the used pairs in `store`. Throws InputError
+/// when the pairs leave a scan unreached or a scan no longer loads,
+/// Cancelled when `stop_requested` fires during fusion, std::runtime_error
+/// when an output cannot be written.
+AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registered, PairStore& store,
+                         MapProgressSink& progress, const MapOutputPaths& outputs,
+                         const std::function<bool()>& stop_requested = {});
+
+struct MapPipelineResult {
+  RegisteredPairs pairs;
+  AssembledMap map;
+};
+
+/// The whole pipeline: RegisterPlannedPairs, then AssembleMap (with the
+/// execution's stop_requested). Throws what either throws.
+MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapProgressSink& progress,
+                                 const PairExecution& execution, const MapOutputPaths& outputs);
+
+}  // namespace boicp
