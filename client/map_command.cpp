@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "boicp/util/atomic_file.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "commands.hpp"
 #include "local_map.hpp"
 #include "map_settings_flags.hpp"
@@ -22,7 +23,7 @@ struct MapFlags {
   MapSettingsFlags map;
   std::string out_dir;
   std::string shard;  // "K/N"; empty = the whole run
-  int threads = 1;
+  int threads = AvailableCores();
   bool json = false;
 };
 
@@ -167,7 +168,9 @@ CommandRunner AddMapCommand(CLI::App& app) {
   MapFlags& f = *flags;
   AddMapSettingsFlags(app, f.map);
   app.add_option("-o,--out", f.out_dir, "Output folder");
-  app.add_option("--threads", f.threads, "Pairs registered at once (one thread each)")
+  app.add_option("--threads", f.threads,
+                 "Pairs registered at once, one thread each (default: every core); the map "
+                 "does not depend on it")
       ->capture_default_str();
   app.add_option("--shard", f.shard,
                  "K/N: register only pairs K-1 mod N into OUTDIR/pairs, no map (then merge)");
