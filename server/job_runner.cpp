@@ -15,7 +15,7 @@
 #include "job_outputs.hpp"
 #include "job_spec.hpp"
 #include "pair_task.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 #include "scan_integrity.hpp"
 
 namespace boicp::server {

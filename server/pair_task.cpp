@@ -1,7 +1,7 @@
 #include "pair_task.hpp"
 
 #include "boicp/mapping/batch_pair.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 
 namespace boicp::server {
 

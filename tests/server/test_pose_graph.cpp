@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/registration/evaluation.hpp"
-#include "boicp/mapping/pose_graph.hpp"
 #include "boicp/io/synthetic_scene.hpp"
+#include "boicp/mapping/pose_graph.hpp"
+#include "boicp/registration/evaluation.hpp"
 
 namespace boicp {
 namespace {
