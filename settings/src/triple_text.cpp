@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
@@ -32,10 +33,20 @@ Eigen::Vector3d ParseTriple(const std::string& text, const std::string& flag) {
   return values;
 }
 
-std::string FormatTriple(const Eigen::Vector3d& values) {
-  char text[96];
-  std::snprintf(text, sizeof(text), "%.17g,%.17g,%.17g", values[0], values[1], values[2]);
+namespace {
+
+// The shortest of %.15g and %.17g that reads back as the same double.
+std::string FormatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.15g", value);
+  if (std::strtod(text, nullptr) != value) std::snprintf(text, sizeof(text), "%.17g", value);
   return text;
+}
+
+}  // namespace
+
+std::string FormatTriple(const Eigen::Vector3d& values) {
+  return FormatNumber(values[0]) + "," + FormatNumber(values[1]) + "," + FormatNumber(values[2]);
 }
 
 }  // namespace boicp::settings

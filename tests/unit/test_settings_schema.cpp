@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "boicp/settings/triple_text.hpp"
 #include "boicp/util/types.hpp"
 #include "settings_examples.hpp"
 
@@ -139,6 +140,12 @@ TEST(SettingSchema, MapSettingsKeepDefaultsAndValidate) {
   EXPECT_THROW(MapBuildFromSettings(s), InputError);
   EXPECT_FALSE(MapAutoFromSettings(s).resolution);
   EXPECT_TRUE(MapAutoFromSettings(s).max_range);
+}
+
+TEST(SettingSchema, BoundsTextIsShortAndExact) {
+  EXPECT_EQ(FormatTriple(Eigen::Vector3d(0.2, 0.5, 4.0)), "0.2,0.5,4");
+  const Eigen::Vector3d turn(M_PI, M_PI / 2, 1.0 / 3.0);
+  EXPECT_EQ(ParseTriple(FormatTriple(turn), "test"), turn);
 }
 
 }  // namespace

@@ -3,7 +3,10 @@
 // each front end (CLI flag, run.json key, boicp.v1 proto field), its help
 // text, and where its value lives. Flags, run.json, the proto conversions
 // and the bench are all generated from this table, so a setting added here
-// reaches every front end at once.
+// reaches every front end at once. BoIcpConfig fields missing from the table
+// (finish_icp_iterations, refine_max_iterations, refine_candidates,
+// refine_source_points, inlier_distance, retry_voxel, bo) are engine tuning
+// that no front end and not the API takes.
 
 #include <cstdint>
 #include <optional>
