@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "boicp/mapping/batch_pair.hpp"
-#include "boicp/registration/config.hpp"
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
+#include "boicp/registration/config.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
 
