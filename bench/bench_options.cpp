@@ -1,11 +1,12 @@
 #include "bench_options.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <functional>
-#include <map>
 #include <sstream>
 
+#include <CLI/CLI.hpp>
+
+#include "boicp/settings/settings_flags.hpp"
+#include "boicp/util/types.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {
@@ -19,44 +20,6 @@ std::vector<std::string> SplitList(const std::string& text) {
     if (!item.empty()) items.push_back(item);
   }
   return items;
-}
-
-double ParseDouble(const std::string& flag, const std::string& text) {
-  try {
-    size_t used = 0;
-    const double value = std::stod(text, &used);
-    if (used == text.size() && std::isfinite(value)) return value;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + ": '" + text + "' is not a number");
-}
-
-double ParsePositive(const std::string& flag, const std::string& text) {
-  const double value = ParseDouble(flag, text);
-  if (value <= 0.0) throw UsageError(flag + ": must be positive, got '" + text + "'");
-  return value;
-}
-
-long long ParseInteger(const std::string& flag, const std::string& text, long long min) {
-  try {
-    size_t used = 0;
-    const long long value = std::stoll(text, &used);
-    if (used == text.size() && value >= min) return value;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + ": expected an integer >= " + std::to_string(min) + ", got '" + text +
-                   "'");
-}
-
-Eigen::Vector3d ParseTriple(const std::string& flag, const std::string& text) {
-  const std::vector<std::string> items = SplitList(text);
-  if (items.size() != 3) throw UsageError(flag + ": expected X,Y,Z, got '" + text + "'");
-  Eigen::Vector3d values;
-  for (int k = 0; k < 3; ++k) {
-    values[k] = ParseDouble(flag, items[k]);
-    if (values[k] < 0.0) throw UsageError(flag + ": values must be >= 0, got '" + text + "'");
-  }
-  return values;
 }
 
 std::vector<std::string> ParseMethods(const std::string& text) {
@@ -77,35 +40,29 @@ std::vector<std::string> ParseMethods(const std::string& text) {
   return ordered;
 }
 
-}  // namespace
-
-std::string UsageText() {
+std::string MethodList() {
   std::string methods;
   for (const std::string& name : MethodNames()) methods += (methods.empty() ? "" : ",") + name;
-  return "usage: boicp-bench (--pairs CSV[,CSV...] | --datasets NAME[,NAME...] | --synthetic N)\n"
-         "                   --out DIR [options]\n"
-         "  --methods M[,M...]        default all: " +
-         methods +
-         "\n"
-         "  --perturb yaw|axis90|any|none  source perturbation (default: per dataset)\n"
-         "  --max-angle-deg A         largest axis perturbation angle (default 90)\n"
-         "  --seed N                  base seed of every random choice (default 1)\n"
-         "  --threads T               thread budget of every method (default 1)\n"
-         "  --voxel V                 search voxel, metres (default: per dataset)\n"
-         "  --rotation-bounds R,P,Y   search half-widths, radians (default: per dataset)\n"
-         "  --translation-bounds X,Y,Z  search half-widths, metres (default: per dataset)\n"
-         "  --max-rot-deg D --max-trans-m M  success thresholds (default: per dataset)\n"
-         "  --max-pairs N             first N pairs of each dataset (default all)\n"
-         "  --data-root DIR           folder of --datasets (default the shared data)\n"
-         "  --scaling NAME[,NAME...]  also time bo-C against points and iterations\n"
-         "                            on the first pair of these datasets\n"
-         "  --synthetic N             add N generated street pairs (no files needed)\n"
-         "  --scaling-only            only the scaling study of the --scaling datasets\n"
-         "  --quick                   smoke-test budgets (see summary.md)\n"
-         "  --auto-settings           BO methods choose voxel and boxes from the clouds\n"
-         "                            (no dataset table); the rest keep the table's\n"
-         "  --no-retry                BO methods never search a doubtful pair again\n";
+  return methods;
 }
+
+// The registration settings the bench takes from the schema become overrides
+// of the dataset table.
+void ApplySchemaSettings(const settings::RequestedSettings& given, DatasetOverrides& o) {
+  if (given.voxel && !(*given.voxel > 0.0)) throw UsageError("--voxel: must be positive");
+  for (const auto& [flag, bounds] : {std::pair{"--rotation-bounds", given.rotation_bounds},
+                                     std::pair{"--translation-bounds", given.translation_bounds}}) {
+    if (bounds && (bounds->array() < 0.0).any()) {
+      throw UsageError(std::string(flag) + ": values must be >= 0");
+    }
+  }
+  o.voxel = given.voxel;
+  o.rotation_bounds = given.rotation_bounds;
+  o.translation_bounds = given.translation_bounds;
+  o.retry_when_doubtful = !given.no_retry;
+}
+
+}  // namespace
 
 BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
   BenchOptions options;
@@ -114,82 +71,83 @@ BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
   for (int i = 0; i < argc; ++i) {
     options.command_line += (i == 0 ? "" : " ") + std::string(argv[i]);
   }
-  std::vector<std::string> datasets;
   DatasetOverrides& o = options.overrides;
+  std::vector<std::string> datasets;
+  settings::RequestedSettings given;
+  settings::FlagTexts given_texts;
 
-  using Handler = std::function<void(const std::string& flag, const std::string& value)>;
-  const std::map<std::string, Handler> with_value = {
-      {"--pairs",
-       [&](auto&, auto& v) {
-         for (const std::string& csv : SplitList(v)) options.pairs_csvs.push_back(csv);
-       }},
-      {"--datasets", [&](auto&, auto& v) { datasets = SplitList(v); }},
-      {"--methods", [&](auto&, auto& v) { options.methods = ParseMethods(v); }},
-      {"--perturb",
-       [&](auto& f, auto& v) {
-         try {
-           o.perturb = ParsePerturbationKind(v);
-         } catch (const std::exception& e) {
-           throw UsageError(f + ": " + e.what());
-         }
-       }},
-      {"--max-angle-deg", [&](auto& f, auto& v) { o.max_angle_deg = ParsePositive(f, v); }},
-      {"--seed",
-       [&](auto& f, auto& v) { options.seed = static_cast<uint64_t>(ParseInteger(f, v, 0)); }},
-      {"--threads",
-       [&](auto& f, auto& v) { options.threads = static_cast<int>(ParseInteger(f, v, 1)); }},
-      {"--out", [&](auto&, auto& v) { options.out_dir = v; }},
-      {"--voxel", [&](auto& f, auto& v) { o.voxel = ParsePositive(f, v); }},
-      {"--rotation-bounds", [&](auto& f, auto& v) { o.rotation_bounds = ParseTriple(f, v); }},
-      {"--translation-bounds", [&](auto& f, auto& v) { o.translation_bounds = ParseTriple(f, v); }},
-      {"--max-rot-deg", [&](auto& f, auto& v) { o.max_rot_deg = ParsePositive(f, v); }},
-      {"--max-trans-m", [&](auto& f, auto& v) { o.max_trans_m = ParsePositive(f, v); }},
-      {"--max-pairs",
-       [&](auto& f, auto& v) { options.max_pairs = static_cast<int>(ParseInteger(f, v, 1)); }},
-      {"--data-root", [&](auto&, auto& v) { options.data_root = v; }},
-      {"--scaling", [&](auto&, auto& v) { options.scaling_datasets = SplitList(v); }},
-      {"--synthetic",
-       [&](auto& f, auto& v) {
-         options.synthetic_pairs = static_cast<int>(ParseInteger(f, v, 1));
-       }},
-  };
+  CLI::App app("Accuracy and runtime of BO-ICP against its baselines", "boicp-bench");
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option_function<std::vector<std::string>>(
+         "--pairs",
+         [&](const std::vector<std::string>& lists) {
+           for (const std::string& list : lists) {
+             for (const std::string& csv : SplitList(list)) options.pairs_csvs.push_back(csv);
+           }
+         },
+         "CSV[,CSV...]: pair lists to run (may be repeated)")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  app.add_option_function<std::string>(
+      "--datasets", [&](const std::string& v) { datasets = SplitList(v); },
+      "NAME[,NAME...]: DATA_ROOT/NAME/pairs.csv");
+  app.add_option_function<int>(
+         "--synthetic", [&](int n) { options.synthetic_pairs = n; },
+         "Add N generated street pairs (no files needed)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--out", options.out_dir, "Output folder (required)");
+  app.add_option_function<std::string>(
+      "--methods", [&](const std::string& v) { options.methods = ParseMethods(v); },
+      "M[,M...]; default all: " + MethodList());
+  app.add_option_function<std::string>(
+      "--perturb",
+      [&](const std::string& v) {
+        try {
+          o.perturb = ParsePerturbationKind(v);
+        } catch (const std::exception& e) {
+          throw UsageError(std::string("--perturb: ") + e.what());
+        }
+      },
+      "yaw|axis90|any|none: source perturbation (default: per dataset)");
+  app.add_option("--max-angle-deg", o.max_angle_deg, "Largest axis perturbation angle (default 90)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", options.seed, "Base seed of every random choice")->capture_default_str();
+  app.add_option("--threads", options.threads, "Thread budget of every method")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  settings::AddSettingFlags(app, settings::kBench, given, given_texts);
+  app.add_option("--max-rot-deg", o.max_rot_deg, "Success threshold (default: per dataset)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-trans-m", o.max_trans_m, "Success threshold (default: per dataset)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-pairs", options.max_pairs, "First N pairs of each dataset (default all)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--data-root", options.data_root, "Folder of --datasets")->capture_default_str();
+  app.add_option_function<std::string>(
+      "--scaling", [&](const std::string& v) { options.scaling_datasets = SplitList(v); },
+      "NAME[,NAME...]: also time bo-C against points and iterations on the first pair of "
+      "these datasets");
+  app.add_flag("--scaling-only", options.scaling_only,
+               "Only the scaling study of the --scaling datasets");
+  app.add_flag("--quick", options.quick, "Smoke-test budgets (see summary.md)");
+  app.add_flag("--auto-settings", o.automatic_settings,
+               "BO methods choose voxel and boxes from the clouds (no dataset table); the rest "
+               "keep the table's");
+  options.usage = app.help();
 
-  for (int i = 1; i < argc; ++i) {
-    std::string flag = argv[i];
-    if (flag == "--quick") {
-      options.quick = true;
-      continue;
-    }
-    if (flag == "--scaling-only") {
-      options.scaling_only = true;
-      continue;
-    }
-    if (flag == "--auto-settings") {
-      o.automatic_settings = true;
-      continue;
-    }
-    if (flag == "--no-retry") {
-      o.retry_when_doubtful = false;
-      continue;
-    }
-    if (flag == "--help" || flag == "-h") {
-      options.help = true;
-      return options;
-    }
-    std::string value;
-    const size_t equals = flag.find('=');
-    if (equals != std::string::npos) {
-      value = flag.substr(equals + 1);
-      flag = flag.substr(0, equals);
-    }
-    const auto handler = with_value.find(flag);
-    if (handler == with_value.end()) throw UsageError("unknown option '" + flag + "'");
-    if (equals == std::string::npos) {
-      if (i + 1 >= argc) throw UsageError(flag + ": missing value");
-      value = argv[++i];
-    }
-    handler->second(flag, value);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    options.help = true;
+    return options;
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(e.what());
   }
+  try {
+    settings::ApplyFlagTexts(given_texts, settings::kBench, given);
+  } catch (const InputError& e) {
+    throw UsageError(e.what());
+  }
+  ApplySchemaSettings(given, o);
 
   for (const std::string& name : datasets) {
     options.pairs_csvs.push_back(options.data_root + "/" + name + "/pairs.csv");

@@ -50,12 +50,12 @@ struct BenchOptions {
   bool scaling_only = false;                  // run the scaling study and skip the suite
   std::string command_line;
   bool help = false;
+  std::string usage;  // the help text, for --help
 };
 
-/// Parses argv. Throws UsageError for unknown flags or methods, missing or
-/// malformed values, and a run with no pairs or no --out.
+/// Parses argv (CLI11; a flag given twice keeps its last value, except
+/// --pairs, whose lists add up). Throws UsageError for unknown flags or
+/// methods, missing or malformed values, and a run with no pairs or no --out.
 BenchOptions ParseBenchOptions(int argc, const char* const* argv);
-
-std::string UsageText();
 
 }  // namespace boicp::bench

@@ -2,25 +2,29 @@
 
 #include <algorithm>
 
+#include "boicp/settings/requested_settings.hpp"
+
 namespace boicp::bench {
 
 BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input) {
-  BoIcpConfig config = PresetConfig(preset);
-  config.retry_when_doubtful = input.dataset.retry_when_doubtful;
+  const BoIcpConfig preset_config = PresetConfig(preset);
+  settings::RequestedSettings given;
+  given.preset = preset;
+  given.seed = input.seed;
+  given.threads = input.threads;
+  given.no_retry = !input.dataset.retry_when_doubtful;
   if (!input.dataset.automatic_settings) {
-    config.automatic.clear();
-    config.voxel = input.dataset.voxel * config.voxel / PresetConfig("C").voxel;
-    config.rotation_bounds = input.dataset.rotation_bounds;
-    config.translation_bounds = input.dataset.translation_bounds;
+    given.fixed_settings = true;
+    given.voxel = input.dataset.voxel * preset_config.voxel / PresetConfig("C").voxel;
+    given.rotation_bounds = input.dataset.rotation_bounds;
+    given.translation_bounds = input.dataset.translation_bounds;
   }
-  config.seed = input.seed;
-  config.threads = input.threads;
   if (input.quick) {
     // The smoke test checks that every method runs, not how well.
-    config.random_samples = std::min(config.random_samples, kQuickBoSamples);
-    config.iterations = std::min(config.iterations, kQuickBoSamples);
+    given.random_samples = std::min(preset_config.random_samples, kQuickBoSamples);
+    given.iterations = std::min(preset_config.iterations, kQuickBoSamples);
   }
-  return config;
+  return settings::ConfigFromSettings(given);
 }
 
 }  // namespace boicp::bench

@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   try {
     options = boicp::bench::ParseBenchOptions(argc, argv);
     if (options.help) {
-      std::cout << boicp::bench::UsageText();
+      std::cout << options.usage;
       return 0;
     }
     // Before anything touches OpenMP or Open3D.

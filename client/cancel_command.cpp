@@ -2,9 +2,9 @@
 
 #include <cstdio>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "commands.hpp"
 #include "remote_options.hpp"
-#include "remote_proto.hpp"
 
 namespace boicp::cli {
 
@@ -26,7 +26,7 @@ CommandRunner AddCancelCommand(CLI::App& app) {
       const v1::Job job = daemon.client->Cancel(flags->job_id);
       if (job.state() == v1::JOB_STATE_SUCCEEDED || job.state() == v1::JOB_STATE_FAILED) {
         std::fprintf(stderr, "job %s had already %s; nothing to cancel\n", job.job_id().c_str(),
-                     JobStateName(job.state()).c_str());
+                     rpc::JobStateName(job.state()).c_str());
       } else {
         std::fprintf(
             stderr, "job %s: %s\n", job.job_id().c_str(),

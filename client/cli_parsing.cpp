@@ -20,29 +20,6 @@ std::optional<Eigen::Vector3d> ParseSensorUp(const std::string& text) {
   return up;
 }
 
-Eigen::Vector3d ParseTriple(const std::string& text, const std::string& flag) {
-  std::stringstream stream(text);
-  std::string item;
-  Eigen::Vector3d values;
-  int count = 0;
-  while (std::getline(stream, item, ',')) {
-    try {
-      size_t used = 0;
-      const double value = item == "pi" ? (used = item.size(), M_PI) : std::stod(item, &used);
-      if (used != item.size() || !std::isfinite(value) || count >= 3)
-        throw std::invalid_argument(item);
-      values[count++] = value;
-    } catch (const std::exception&) {
-      throw InputError(flag + ": expected three comma-separated numbers (or pi), got '" + text +
-                       "'");
-    }
-  }
-  if (count != 3) {
-    throw InputError(flag + ": expected three comma-separated numbers (or pi), got '" + text + "'");
-  }
-  return values;
-}
-
 bool StderrIsTerminal() { return isatty(STDERR_FILENO) == 1; }
 
 }  // namespace boicp::cli

@@ -6,10 +6,11 @@
 
 #include <Eigen/Core>
 
+#include "boicp/settings/triple_text.hpp"
+
 namespace boicp::cli {
 
-/// "a,b,c": three finite numbers, each also "pi". Throws InputError naming `flag`.
-Eigen::Vector3d ParseTriple(const std::string& text, const std::string& flag);
+using settings::ParseTriple;
 
 /// The --sensor-up value: a non-zero "x,y,z" direction in the scan frame,
 /// or nullopt for an empty text. Throws boicp::InputError otherwise.

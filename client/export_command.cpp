@@ -7,11 +7,11 @@
 
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/mapping/map_preview.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "remote_options.hpp"
-#include "remote_proto.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -60,7 +60,7 @@ std::pair<ExportKind, std::string> ResolveFormat(const ExportFlags& f) {
 
 // The job's poses for the preview, through a KITTI trajectory export:
 // unlike GetResults it has no message-size limit however many scans.
-std::vector<Transform> TrajectoryOf(client::MapBuilderClient& client, const std::string& job_id,
+std::vector<Transform> TrajectoryOf(rpc::MapBuilderClient& client, const std::string& job_id,
                                     const std::string& tmp_path) {
   struct RemoveOnExit {
     std::string path;
@@ -80,7 +80,7 @@ int RunExport(const ExportFlags& f) {
   Daemon daemon = ConnectToDaemon(f.remote);
   const v1::Job job = daemon.client->GetJob(f.job_id);
   if (job.state() != v1::JOB_STATE_SUCCEEDED) {
-    throw std::runtime_error("job " + f.job_id + " is " + JobStateName(job.state()) +
+    throw std::runtime_error("job " + f.job_id + " is " + rpc::JobStateName(job.state()) +
                              "; only a succeeded job can be exported");
   }
   const fs::path parent = fs::path(output).parent_path();

@@ -3,8 +3,8 @@
 
 #include <cstdio>
 
+#include "boicp/rpc/health_check.hpp"
 #include "commands.hpp"
-#include "health_check.hpp"
 #include "remote_options.hpp"
 
 namespace boicp::cli {
@@ -18,9 +18,9 @@ CommandRunner AddHealthCommand(CLI::App& app) {
   return [remote] {
     return RunRemote("health", *remote, [&] {
       const Daemon daemon = ConnectToDaemon(*remote);
-      const client::ServingStatus status = client::CheckHealth(daemon.channel, kControlTimeout);
-      std::printf("%s\n", client::ServingStatusName(status).c_str());
-      return status == client::ServingStatus::kServing ? kOk : kFailure;
+      const rpc::ServingStatus status = rpc::CheckHealth(daemon.channel, kControlTimeout);
+      std::printf("%s\n", rpc::ServingStatusName(status).c_str());
+      return status == rpc::ServingStatus::kServing ? kOk : kFailure;
     });
   };
 }

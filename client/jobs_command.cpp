@@ -28,7 +28,7 @@ std::string FormatTime(double unix_seconds) {
   return text;
 }
 
-std::vector<v1::Job> FetchJobs(client::MapBuilderClient& client, int limit) {
+std::vector<v1::Job> FetchJobs(rpc::MapBuilderClient& client, int limit) {
   std::vector<v1::Job> jobs;
   std::string token;
   do {
@@ -50,7 +50,7 @@ void PrintTable(const std::vector<v1::Job>& jobs) {
     const std::string pairs =
         std::to_string(job.pairs_done()) + "/" + std::to_string(job.pairs_total());
     std::printf("%-36s  %-9s  %-11s  %-11s  %5u  %-16s  %s\n", job.job_id().c_str(),
-                JobStateName(job.state()).c_str(), job.stage().c_str(), pairs.c_str(),
+                rpc::JobStateName(job.state()).c_str(), job.stage().c_str(), pairs.c_str(),
                 job.num_scans(), FormatTime(job.created_at()).c_str(), job.label().c_str());
   }
 }

@@ -4,6 +4,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "boicp/mapping/map_preview.hpp"
+#include "boicp/settings/setting_schema.hpp"
+#include "boicp/settings/settings_json.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 #include "json_output.hpp"
 
@@ -24,30 +28,10 @@ std::string PairName(const PairIndex& p) {
 }
 
 BoIcpConfig BuildConfig(const MapSettings& s) {
-  BoIcpConfig config = PresetConfig(s.preset);
-  if (s.fixed_settings) config.automatic.clear();
-  config.mode = ParseSearchMode(s.mode);
-  config.retry_when_doubtful = !s.no_retry;
-  if (s.voxel) {
-    config.voxel = *s.voxel;
-    config.MarkSet("voxel");
-  }
-  if (s.random_samples) config.random_samples = *s.random_samples;
-  if (s.iterations) config.iterations = *s.iterations;
-  if (!s.rotation_bounds.empty()) {
-    config.rotation_bounds =
-        SnapRotationBounds(ParseTriple(s.rotation_bounds, "--rotation-bounds"));
-    config.MarkSet("rotation_bounds");
-  }
-  if (!s.translation_bounds.empty()) {
-    config.translation_bounds = ParseTriple(s.translation_bounds, "--translation-bounds");
-    config.MarkSet("translation_bounds");
-  }
-  config.seed = s.seed;
+  BoIcpConfig config = settings::ConfigFromSettings(s);
   // Parallelism is across pairs; inside one registration it is one thread,
   // as the daemon's default --registration-threads.
   config.threads = 1;
-  ValidateConfig(config);
   return config;
 }
 
@@ -66,58 +50,30 @@ ScanFolderOptions FolderOptions(const MapSettings& s) {
 
 }  // namespace
 
-json Nullable(const std::optional<double>& value) { return value ? json(*value) : json(nullptr); }
-
-std::optional<double> NullableFromJson(const json& j, const char* key) {
-  if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
-  return j.at(key).get<double>();
-}
-
 json MapSettingsToJson(const MapSettings& s) {
-  return {{"path", s.path},
-          {"layout", s.layout},
-          {"config", s.preset},
-          {"mode", s.mode},
-          {"pairing", s.pairing},
-          {"pairs_file", s.pairs_file},
-          {"resolution", Nullable(s.resolution)},
-          {"max_range", Nullable(s.max_range)},
-          {"fixed_settings", s.fixed_settings},
-          {"no_retry", s.no_retry},
-          {"voxel", Nullable(s.voxel)},
-          {"random_samples", s.random_samples ? json(*s.random_samples) : json(nullptr)},
-          {"iterations", s.iterations ? json(*s.iterations) : json(nullptr)},
-          {"rotation_bounds", s.rotation_bounds},
-          {"translation_bounds", s.translation_bounds},
-          {"seed", s.seed},
-          {"first", s.first},
-          {"stride", s.stride},
-          {"count", s.count},
-          {"intrinsics", s.intrinsics},
-          {"camera", s.camera},
-          {"depth_scale", s.depth_scale},
-          {"poses_as_priors", s.poses_as_priors}};
+  json out = settings::SettingsToJson(s, settings::kMap);
+  out.update({{"path", s.path},
+              {"layout", s.layout},
+              {"pairing", s.pairing},
+              {"pairs_file", s.pairs_file},
+              {"first", s.first},
+              {"stride", s.stride},
+              {"count", s.count},
+              {"intrinsics", s.intrinsics},
+              {"camera", s.camera},
+              {"depth_scale", s.depth_scale},
+              {"poses_as_priors", s.poses_as_priors}});
+  return out;
 }
 
 MapSettings MapSettingsFromJson(const json& j, const std::string& source) {
+  MapSettings s;
+  settings::SettingsFromJson(j, settings::kMap, source, s);
   try {
-    MapSettings s;
     s.path = j.at("path").get<std::string>();
     s.layout = j.at("layout").get<std::string>();
-    s.preset = j.at("config").get<std::string>();
     s.pairing = j.at("pairing").get<std::string>();
     s.pairs_file = j.at("pairs_file").get<std::string>();
-    s.mode = j.value("mode", std::string("nested"));
-    s.resolution = NullableFromJson(j, "resolution");
-    s.max_range = NullableFromJson(j, "max_range");
-    s.fixed_settings = j.value("fixed_settings", false);
-    s.no_retry = j.value("no_retry", false);
-    s.voxel = NullableFromJson(j, "voxel");
-    if (!j.at("random_samples").is_null()) s.random_samples = j.at("random_samples").get<int>();
-    if (!j.at("iterations").is_null()) s.iterations = j.at("iterations").get<int>();
-    s.rotation_bounds = j.at("rotation_bounds").get<std::string>();
-    s.translation_bounds = j.at("translation_bounds").get<std::string>();
-    s.seed = j.at("seed").get<uint64_t>();
     s.first = j.at("first").get<int>();
     s.stride = j.at("stride").get<int>();
     s.count = j.at("count").get<int>();

@@ -14,27 +14,19 @@
 
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/settings/requested_settings.hpp"
 #include "local_pairs.hpp"
 
 namespace boicp::cli {
 
-/// Every setting of a map run; what run.json stores.
-struct MapSettings {
+/// Every setting of a map run; what run.json stores. The registration and
+/// map settings are the schema's (boicp/settings/setting_schema.hpp); the
+/// rest say which scans to read and how to pair them.
+struct MapSettings : settings::RequestedSettings {
   std::string path;  // scan folder (made absolute)
   std::string layout = "auto";
-  std::string preset = "C";
   std::string pairing = "consecutive";  // consecutive | overlap | explicit
   std::string pairs_file;               // explicit pairing: "source,target" lines
-  std::string mode = "nested";          // nested | 6dof
-  // OctoMap leaf and ray cut, metres (ray cut 0 = none); unset = from the scans.
-  std::optional<double> resolution, max_range;
-  std::optional<double> voxel;  // search voxel override, metres; unset = from the scans
-  // N_r and N per search stage; unset = the preset's.
-  std::optional<int> random_samples, iterations;
-  std::string rotation_bounds, translation_bounds;  // "a,b,c" overrides; empty = from the scans
-  bool fixed_settings = false;  // the preset's fixed voxel, bounds and map settings
-  bool no_retry = false;        // never search a doubtful pair again
-  uint64_t seed = 1;
   int first = 0, stride = 1, count = 0;
   std::string intrinsics;  // "fx,fy,cx,cy"
   std::string camera;      // TUM fr1|fr2|fr3

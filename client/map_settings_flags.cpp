@@ -2,34 +2,17 @@
 
 namespace boicp::cli {
 
-void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags) {
+void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Frontend frontend) {
   MapSettings& s = flags.settings;
+  flags.frontend = frontend;
   app.add_option("PATH", s.path, "Scan folder (KITTI, TUM, 7-Scenes, or .pcd/.ply/.xyz files)");
   app.add_option("--layout", s.layout, "auto, kitti, tum, 7scenes or files")->capture_default_str();
-  app.add_option("--config", s.preset, "BO-ICP preset A, B or C")->capture_default_str();
   app.add_option("--pairing", flags.pairing_words,
                  "consecutive, overlap (keyframes by overlap) or explicit FILE (lines of "
                  "'source,target' scan indices)")
       ->expected(1, -1)
       ->default_str("consecutive");
-  app.add_option("--mode", s.mode, "nested (rotation then translation) or 6dof")
-      ->capture_default_str();
-  app.add_option("--resolution", s.resolution, "OctoMap leaf size (m); default: from the scans");
-  app.add_option("--max-range", s.max_range,
-                 "OctoMap ray length (m), 0 = no limit; default: from the scans");
-  app.add_option("--voxel", s.voxel, "Search voxel (m); default: from the scans");
-  app.add_option("--random-samples", s.random_samples,
-                 "N_r per search stage; default: the preset's");
-  app.add_option("--iterations", s.iterations, "N per search stage; default: the preset's");
-  app.add_option("--rotation-bounds", s.rotation_bounds,
-                 "Half-widths roll,pitch,yaw (rad, or pi); default: from the sensor");
-  app.add_option("--translation-bounds", s.translation_bounds,
-                 "Half-widths x,y,z (m); default: from the scans");
-  app.add_flag("--fixed-settings", s.fixed_settings,
-               "The preset's fixed voxel, bounds and map settings instead of choosing them");
-  app.add_flag("--no-retry", s.no_retry, "Never search a doubtful pair again");
-  app.add_option("--seed", s.seed, "Job seed; each pair's seed derives from it")
-      ->capture_default_str();
+  settings::AddSettingFlags(app, frontend, s, flags.setting_texts);
   app.add_option("--first", s.first, "Index of the first scan kept")->capture_default_str();
   app.add_option("--stride", s.stride, "Keep every N-th scan")->capture_default_str();
   app.add_option("--count", s.count, "At most N scans; 0 = all")->capture_default_str();
@@ -43,6 +26,7 @@ void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags) {
 
 MapSettings ResolveMapSettings(const MapSettingsFlags& flags) {
   MapSettings s = flags.settings;
+  settings::ApplyFlagTexts(flags.setting_texts, flags.frontend, s);
   std::vector<std::string> words = flags.pairing_words;
   if (words.empty()) words = {"consecutive"};
   s.pairing = words[0];

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "boicp/settings/settings_flags.hpp"
 #include "local_pipeline.hpp"
 
 namespace boicp::cli {
@@ -16,14 +17,18 @@ namespace boicp::cli {
 /// handed to --pairing: MODE, FILE for explicit, and PATH when PATH came last.
 struct MapSettingsFlags {
   MapSettings settings;
+  settings::FlagTexts setting_texts;
+  settings::Frontend frontend = settings::kMap;
   std::vector<std::string> pairing_words = {"consecutive"};
 };
 
-/// Registers PATH and the shared flags on `app`.
-void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags);
+/// Registers PATH and the shared flags on `app`, with the settings the
+/// schema gives `frontend` (kMap or kSubmit).
+void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags,
+                         settings::Frontend frontend = settings::kMap);
 
 /// The settings with --pairing's words split into mode, FILE and PATH.
-/// Throws InputError for a stray word or a missing PATH.
+/// Throws InputError for a stray word, a missing PATH or a malformed value.
 MapSettings ResolveMapSettings(const MapSettingsFlags& flags);
 
 }  // namespace boicp::cli

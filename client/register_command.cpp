@@ -10,6 +10,7 @@
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
+#include "boicp/settings/settings_flags.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
@@ -18,58 +19,19 @@ namespace boicp::cli {
 namespace {
 
 struct RegisterFlags {
-  std::string source, target, preset = "C", mode = "nested", format = "auto";
+  std::string source, target, format = "auto";
   std::string intrinsics, intrinsics_file, prior_file;
-  std::string translation_bounds, rotation_bounds;
   std::vector<int> invalid_depth = {0, 65535};
   double depth_scale = 0.0;
-  std::optional<double> voxel, refine_voxel, max_correspondence, truncation, min_range, max_range;
-  std::optional<int> random_samples, iterations, icp_iterations;
-  std::optional<size_t> evaluation_points;
-  std::optional<size_t> coarse_icp_points;
-  uint64_t seed = 1;
-  int threads = 1;
-  bool json = false, quiet = false, fixed_settings = false, no_retry = false;
+  settings::RequestedSettings settings;
+  settings::FlagTexts setting_texts;
+  bool json = false, quiet = false;
 };
 
 BoIcpConfig BuildConfig(const RegisterFlags& f) {
-  BoIcpConfig config = PresetConfig(f.preset);
-  if (f.fixed_settings) config.automatic.clear();
-  config.mode = ParseSearchMode(f.mode);
-  config.retry_when_doubtful = !f.no_retry;
-  if (f.voxel) {
-    config.voxel = *f.voxel;
-    config.MarkSet("voxel");
-  }
-  if (f.refine_voxel) {
-    config.refine_voxel = *f.refine_voxel;
-    config.MarkSet("refine_voxel");
-  }
-  if (f.max_correspondence) config.max_correspondence_distance = *f.max_correspondence;
-  if (f.truncation) {
-    config.objective_truncation = *f.truncation;
-    config.MarkSet("objective_truncation");
-  }
-  if (f.icp_iterations) config.icp_max_iterations = *f.icp_iterations;
-  if (f.min_range) config.min_range = *f.min_range;
-  if (f.max_range) config.max_range = *f.max_range;
-  if (f.random_samples) config.random_samples = *f.random_samples;
-  if (f.iterations) config.iterations = *f.iterations;
-  if (f.evaluation_points) config.evaluation_points = *f.evaluation_points;
-  if (f.coarse_icp_points) config.coarse_icp_points = *f.coarse_icp_points;
-  if (!f.translation_bounds.empty()) {
-    config.translation_bounds = ParseTriple(f.translation_bounds, "--translation-bounds");
-    config.MarkSet("translation_bounds");
-  }
-  if (!f.rotation_bounds.empty()) {
-    config.rotation_bounds =
-        SnapRotationBounds(ParseTriple(f.rotation_bounds, "--rotation-bounds"));
-    config.MarkSet("rotation_bounds");
-  }
-  config.seed = f.seed;
-  config.threads = f.threads;
-  ValidateConfig(config);
-  return config;
+  settings::RequestedSettings given = f.settings;
+  settings::ApplyFlagTexts(f.setting_texts, settings::kRegister, given);
+  return settings::ConfigFromSettings(given);
 }
 
 LoadOptions BuildLoadOptions(const RegisterFlags& f) {
@@ -162,18 +124,8 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
   RegisterFlags& f = *flags;
   app.add_option("--source", f.source, "Source scan (moved onto the target)")->required();
   app.add_option("--target", f.target, "Target scan")->required();
-  app.add_option("--config", f.preset, "Preset A, B or C (the paper's)")->capture_default_str();
-  app.add_option("--mode", f.mode, "nested (rotation then translation) or 6dof")
-      ->capture_default_str();
-  app.add_option("--seed", f.seed, "Seed for every random choice")->capture_default_str();
   app.add_flag("--json", f.json, "Print one JSON object on stdout");
-  app.add_flag("--fixed-settings", f.fixed_settings,
-               "Use the preset's fixed voxel and bounds instead of choosing them from the clouds");
-  app.add_flag("--no-retry", f.no_retry, "Do not search again when the answer is doubtful");
   app.add_flag("-q,--quiet", f.quiet, "No progress on stderr");
-  app.add_option("--threads", f.threads,
-                 "Threads for the search and the refinement (the answer does not depend on it)")
-      ->capture_default_str();
   app.add_option("--format", f.format, "auto, kitti, pcd, ply, xyz or depth")
       ->capture_default_str();
   app.add_option("--intrinsics", f.intrinsics, "Depth camera fx,fy,cx,cy (pixels)");
@@ -184,26 +136,7 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--prior", f.prior_file, "Initial guess: file with a 4x4 or 3x4 T_target_source");
-  app.add_option("--voxel", f.voxel, "Search voxel size (metres; default: from the clouds)");
-  app.add_option("--refine-voxel", f.refine_voxel,
-                 "Final ICP voxel size (metres; default: from the clouds)");
-  app.add_option("--max-correspondence", f.max_correspondence,
-                 "ICP correspondence gate during the search (metres; default 3 x voxel)");
-  app.add_option("--objective-truncation", f.truncation,
-                 "Clipping distance of the search objective (metres; default 1.5 x voxel)");
-  app.add_option("--icp-iterations", f.icp_iterations, "ICP iterations per evaluation");
-  app.add_option("--translation-bounds", f.translation_bounds,
-                 "Half-widths X,Y,Z (metres; default: from the clouds)");
-  app.add_option("--rotation-bounds", f.rotation_bounds,
-                 "Half-widths roll,pitch,yaw (radians, or pi; default: from the sensor)");
-  app.add_option("--random-samples", f.random_samples, "N_r: initial samples per stage");
-  app.add_option("--iterations", f.iterations, "N: BO iterations per stage");
-  app.add_option("--evaluation-points", f.evaluation_points,
-                 "Source points used by each evaluation (0 = all)");
-  app.add_option("--coarse-icp-points", f.coarse_icp_points,
-                 "Points each evaluation's ICP starts on before it finishes on all (0 = all)");
-  app.add_option("--min-range", f.min_range, "Drop points closer than this (metres)");
-  app.add_option("--max-range", f.max_range, "Drop points farther than this (metres)");
+  settings::AddSettingFlags(app, settings::kRegister, f.settings, f.setting_texts);
   return [flags] { return RunRegister(*flags); };
 }
 

@@ -47,7 +47,7 @@ nlohmann::json JobToJson(const v1::Job& job) {
   return {
       {"job_id", job.job_id()},
       {"label", job.label()},
-      {"state", JobStateName(job.state())},
+      {"state", rpc::JobStateName(job.state())},
       {"stage", job.stage()},
       {"pairs_done", job.pairs_done()},
       {"pairs_total", job.pairs_total()},
@@ -71,7 +71,7 @@ nlohmann::json PairToJson(const v1::PairResult& pair) {
       {"target", pair.target()},
       {"source_scan_id", pair.source_scan_id()},
       {"target_scan_id", pair.target_scan_id()},
-      {"transform", TransformToJson(TransformFromProto(pair.transform(), "pair.transform"))},
+      {"transform", TransformToJson(rpc::TransformFromProto(pair.transform(), "pair.transform"))},
       {"objective", pair.objective()},
       {"fitness", pair.fitness()},
       {"inlier_rmse", pair.inlier_rmse()},
@@ -95,7 +95,7 @@ nlohmann::json ResultsToJson(const v1::JobResults& results) {
         {{"index", pose.index()},
          {"scan_id", pose.scan_id()},
          {"timestamp", pose.timestamp()},
-         {"pose", TransformToJson(TransformFromProto(pose.pose(), "trajectory.pose"))}});
+         {"pose", TransformToJson(rpc::TransformFromProto(pose.pose(), "trajectory.pose"))}});
   }
   return json;
 }

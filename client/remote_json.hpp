@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "remote_proto.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 
 namespace boicp::cli {
 

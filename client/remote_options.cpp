@@ -33,7 +33,7 @@ std::string OneLine(std::string text) {
   return text;
 }
 
-std::string DescribeRpcError(const client::RpcError& e, const RemoteFlags& flags) {
+std::string DescribeRpcError(const rpc::RpcError& e, const RemoteFlags& flags) {
   switch (e.code()) {
     case grpc::StatusCode::UNAVAILABLE:
       return "cannot reach the daemon at " + flags.server + " (" + e.detail() + ")";
@@ -80,7 +80,7 @@ void AddRemoteOptions(CLI::App& app, RemoteFlags& flags) {
 }
 
 Daemon ConnectToDaemon(const RemoteFlags& flags) {
-  client::ConnectOptions options;
+  rpc::ConnectOptions options;
   options.address = flags.server;
   options.max_message_bytes = kMaxReceiveBytes;
   if (!flags.token_file.empty()) {
@@ -107,8 +107,8 @@ Daemon ConnectToDaemon(const RemoteFlags& flags) {
     options.tls_key_file = flags.tls_key;
   }
   Daemon daemon;
-  daemon.channel = client::Connect(options);
-  daemon.client = std::make_unique<client::MapBuilderClient>(daemon.channel, options.token);
+  daemon.channel = rpc::Connect(options);
+  daemon.client = std::make_unique<rpc::MapBuilderClient>(daemon.channel, options.token);
   daemon.client->set_unary_timeout(kControlTimeout);
   return daemon;
 }
@@ -121,7 +121,7 @@ int RunRemote(const std::string& command, const RemoteFlags& flags,
   };
   try {
     return body();
-  } catch (const client::RpcError& e) {
+  } catch (const rpc::RpcError& e) {
     return report(DescribeRpcError(e, flags), IsBadInput(e.code()) ? kBadInput : kFailure);
   } catch (const InputError& e) {
     return report(e.what(), kBadInput);

@@ -10,7 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "map_builder_client.hpp"
+#include "boicp/rpc/map_builder_client.hpp"
 
 namespace boicp::cli {
 
@@ -39,7 +39,7 @@ void AddRemoteOptions(CLI::App& app, RemoteFlags& flags);
 /// kControlTimeout.
 struct Daemon {
   std::shared_ptr<grpc::Channel> channel;
-  std::unique_ptr<client::MapBuilderClient> client;
+  std::unique_ptr<rpc::MapBuilderClient> client;
 };
 
 /// Reads the token (surrounding whitespace ignored, as the daemon does) and

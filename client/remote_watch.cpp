@@ -38,7 +38,7 @@ void PrintOutcome(const v1::Job& job) {
                           std::to_string(job.pairs_total()) + " pairs");
     default:
       throw std::runtime_error("job " + job.job_id() + ": the watch ended while it was " +
-                               JobStateName(job.state()));
+                               rpc::JobStateName(job.state()));
   }
 }
 
@@ -80,7 +80,7 @@ std::string ProgressLine(const v1::Job& job, const std::optional<v1::PairResult>
     std::snprintf(text, sizeof text, " | %.1f pairs/min", pairs_per_min);
     line += text;
   }
-  if (job.eta_seconds() >= 0.0 && !IsFinal(job.state())) {
+  if (job.eta_seconds() >= 0.0 && !rpc::IsTerminal(job.state())) {
     line += " | ETA " + FormatDuration(job.eta_seconds());
   }
   if (registering && last_pair) {
@@ -132,7 +132,7 @@ void ProgressPrinter::Finish() {
 
 int FollowJob(Daemon& daemon, const std::string& job_id) {
   v1::Job job = daemon.client->GetJob(job_id);  // fails fast: unreachable daemon, unknown job
-  if (!IsFinal(job.state())) {
+  if (!rpc::IsTerminal(job.state())) {
     ProgressPrinter printer(StderrIsTerminal());
     try {
       job = daemon.client->Watch(job_id,

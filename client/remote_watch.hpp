@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "remote_options.hpp"
-#include "remote_proto.hpp"
 
 namespace boicp::cli {
 

@@ -22,7 +22,7 @@ void PrintSummary(const v1::JobResults& results) {
   const v1::Job& job = results.job();
   std::printf("job         %s\n", job.job_id().c_str());
   if (!job.label().empty()) std::printf("label       %s\n", job.label().c_str());
-  std::printf("state       %s (stage %s)%s\n", JobStateName(job.state()).c_str(),
+  std::printf("state       %s (stage %s)%s\n", rpc::JobStateName(job.state()).c_str(),
               job.stage().c_str(), job.cancel_requested() ? ", cancel requested" : "");
   std::printf("scans       %u\n", job.num_scans());
   std::printf("pairs       %u of %u done, %u doubtful%s\n", job.pairs_done(), job.pairs_total(),
@@ -42,7 +42,7 @@ void PrintSummary(const v1::JobResults& results) {
               "time");
   int doubtful = 0;
   for (const v1::PairResult& p : results.pairs()) {
-    const Transform T = TransformFromProto(p.transform(), "pair.transform");
+    const Transform T = rpc::TransformFromProto(p.transform(), "pair.transform");
     char overlap[32] = "-";  // unknown in results stored before it was computed
     if (p.has_overlap()) std::snprintf(overlap, sizeof overlap, "%.3f", p.overlap());
     std::printf("%6u %6u %8.3f %8s %10.3f %11.4f %8.4f %7u %9.3f %9.2f %5s%s%s\n", p.source(),

@@ -5,12 +5,13 @@
 #include <chrono>
 #include <cstdio>
 
+#include "boicp/rpc/proto_convert.hpp"
+#include "boicp/rpc/settings_proto.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "local_pipeline.hpp"
 #include "map_settings_flags.hpp"
 #include "remote_options.hpp"
-#include "remote_proto.hpp"
 #include "remote_watch.hpp"
 
 namespace boicp::cli {
@@ -24,12 +25,6 @@ struct SubmitFlags {
   std::string label;
   bool wait = false;
 };
-
-void SetVector(const Eigen::Vector3d& v, v1::Vector3* out) {
-  out->set_x(v.x());
-  out->set_y(v.y());
-  out->set_z(v.z());
-}
 
 // The batch as PrepareRun validated it; only what the user set overrides
 // the daemon's preset, so both sides apply the same defaults.
@@ -51,26 +46,14 @@ v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
       }
     }
   }
-  v1::RegistrationConfig& config = *request.mutable_config();
-  config.set_preset(s.preset);
-  if (s.voxel) config.set_voxel(*s.voxel);
-  if (s.random_samples) config.set_random_samples(*s.random_samples);
-  if (s.iterations) config.set_iterations(*s.iterations);
-  if (!s.rotation_bounds.empty()) {
-    SetVector(run.config.rotation_bounds, config.mutable_rotation_bounds());
-  }
-  if (!s.translation_bounds.empty()) {
-    SetVector(run.config.translation_bounds, config.mutable_translation_bounds());
-  }
-  config.set_seed(s.seed);
-  config.set_mode(s.mode);
-  config.set_fixed_settings(s.fixed_settings);
-  config.set_no_retry(s.no_retry);
-  // Unset map settings are chosen by the daemon from the uploaded scans.
-  if (s.resolution || s.fixed_settings) {
+  *request.mutable_config() = rpc::RegistrationConfigToProto(s);
+  // The map settings PrepareRun leaves to the daemon (sensor model, cloud
+  // voxel) are checked here too, before any upload.
+  settings::MapBuildFromSettings(s);
+  *request.mutable_map() = rpc::MapSettingsToProto(s);
+  if (s.fixed_settings) {
+    // The fixed map settings, as this client validated them.
     request.mutable_map()->set_resolution(run.map.occupancy.resolution);
-  }
-  if (s.max_range || s.fixed_settings) {
     request.mutable_map()->set_max_range(run.map.occupancy.max_range);
   }
   request.set_label(f.label.empty() ? s.path : f.label);
@@ -79,7 +62,7 @@ v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
 
 // Uploads every scan (only metadata for bytes the daemon already holds),
 // with progress on stderr; returns the scan ids in order.
-std::vector<std::string> UploadScans(client::MapBuilderClient& client, const ScanFolder& folder,
+std::vector<std::string> UploadScans(rpc::MapBuilderClient& client, const ScanFolder& folder,
                                      const std::vector<v1::ScanMetadata>& metadata) {
   const bool terminal = StderrIsTerminal();
   const auto start = Clock::now();
@@ -117,7 +100,7 @@ int RunSubmit(SubmitFlags& f) {
   const ScanFolder& folder = run.folder;
   v1::SubmitBatchRequest request = BuildRequest(f, run);
   std::vector<v1::ScanMetadata> metadata;
-  for (const ScanSource& scan : folder.scans) metadata.push_back(ScanMetadataOf(scan));
+  for (const ScanSource& scan : folder.scans) metadata.push_back(rpc::ScanMetadataOf(scan));
 
   Daemon daemon = ConnectToDaemon(f.remote);
   daemon.client->ListJobs(1);  // reachable and the token accepted, before the slow checks
@@ -145,7 +128,7 @@ int RunSubmit(SubmitFlags& f) {
 CommandRunner AddSubmitCommand(CLI::App& app) {
   auto flags = std::make_shared<SubmitFlags>();
   SubmitFlags& f = *flags;
-  AddMapSettingsFlags(app, f.map);
+  AddMapSettingsFlags(app, f.map, settings::kSubmit);
   app.add_option("--label", f.label, "Free text shown by jobs; default: PATH");
   app.add_flag("--wait", f.wait,
                "Then follow the job like watch; the exit code is watch's (0 only if it "

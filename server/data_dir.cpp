@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "boicp/util/types.hpp"
-#include "sha256.hpp"
+#include "rpc_names.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {

@@ -7,7 +7,7 @@
 
 #include "job_spec.hpp"
 #include "log_text.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 #include "service_error.hpp"
 #include "storage_check.hpp"
 

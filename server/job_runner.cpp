@@ -12,7 +12,7 @@
 #include "job_outputs.hpp"
 #include "job_pair_store.hpp"
 #include "job_spec.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 #include "scan_integrity.hpp"
 
 namespace boicp::server {

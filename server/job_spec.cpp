@@ -4,17 +4,13 @@
 #include <limits>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/rpc/settings_proto.hpp"
+#include "boicp/settings/requested_settings.hpp"
 #include "job_limits.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 
 namespace boicp::server {
 namespace {
-
-Eigen::Vector3d Bounds(const v1::Vector3& proto, const std::string& field) {
-  const Point p = PointFromProto(proto, field);
-  if ((p.array() < 0.0).any()) throw InputError(field + ": half-widths must be >= 0");
-  return p;
-}
 
 std::vector<PairIndex> PairsFromProto(const v1::PairingPolicy& pairing) {
   std::vector<PairIndex> pairs;
@@ -27,61 +23,20 @@ std::vector<PairIndex> PairsFromProto(const v1::PairingPolicy& pairing) {
 }  // namespace
 
 BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads) {
-  BoIcpConfig config = PresetConfig(proto.preset().empty() ? "C" : proto.preset());
-  if (proto.fixed_settings()) config.automatic.clear();
-  config.retry_when_doubtful = !proto.no_retry();
-  if (!proto.mode().empty()) config.mode = ParseSearchMode(proto.mode());
-  if (proto.has_voxel()) {
-    config.voxel = proto.voxel();
-    config.MarkSet("voxel");
-  }
-  if (proto.has_random_samples()) config.random_samples = proto.random_samples();
-  if (proto.has_iterations()) config.iterations = proto.iterations();
-  if (proto.has_rotation_bounds()) {
-    config.rotation_bounds =
-        SnapRotationBounds(Bounds(proto.rotation_bounds(), "config.rotation_bounds"));
-    config.MarkSet("rotation_bounds");
-  }
-  if (proto.has_translation_bounds()) {
-    config.translation_bounds = Bounds(proto.translation_bounds(), "config.translation_bounds");
-    config.MarkSet("translation_bounds");
-  }
-  if (proto.has_seed()) config.seed = proto.seed();
-  if (proto.has_evaluation_points()) config.evaluation_points = proto.evaluation_points();
-  if (proto.has_refine_voxel()) {
-    config.refine_voxel = proto.refine_voxel();
-    config.MarkSet("refine_voxel");
-  }
-  if (proto.has_max_correspondence()) {
-    config.max_correspondence_distance = proto.max_correspondence();
-  }
-  if (proto.has_min_range()) config.min_range = proto.min_range();
-  if (proto.has_max_range()) config.max_range = proto.max_range();
-  config.threads = threads;
   try {
-    ValidateConfig(config);
+    BoIcpConfig config = settings::ConfigFromSettings(rpc::SettingsFromProto(proto, {}));
+    config.threads = threads;
+    return config;
   } catch (const InputError& e) {
-    throw InputError(std::string("config: ") + e.what());
+    const std::string message = e.what();
+    // SettingsFromProto already names the field ("config.voxel: ...").
+    if (message.rfind("config.", 0) == 0) throw;
+    throw InputError("config: " + message);
   }
-  return config;
 }
 
 MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto) {
-  MapBuildSettings settings;
-  OccupancySettings& o = settings.occupancy;
-  if (proto.has_resolution()) o.resolution = proto.resolution();
-  if (proto.has_max_range()) o.max_range = proto.max_range();
-  const v1::SensorModel& model = proto.sensor_model();
-  if (model.prob_hit() != 0.0) o.prob_hit = model.prob_hit();
-  if (model.prob_miss() != 0.0) o.prob_miss = model.prob_miss();
-  if (model.clamp_min() != 0.0) o.clamp_min = model.clamp_min();
-  if (model.clamp_max() != 0.0) o.clamp_max = model.clamp_max();
-  ValidateOccupancySettings(o);
-  settings.cloud_voxel = proto.cloud_voxel();
-  if (!std::isfinite(settings.cloud_voxel) || settings.cloud_voxel < 0.0) {
-    throw InputError("map settings: cloud_voxel must be >= 0 (0 = resolution)");
-  }
-  return settings;
+  return settings::MapBuildFromSettings(rpc::SettingsFromProto({}, proto));
 }
 
 JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& request,
@@ -149,30 +104,15 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
   }
   spec.config = ConfigFromProto(request.config(), registration_threads);
   spec.map = MapSettingsFromProto(request.map());
-  const bool fixed = request.config().fixed_settings();
-  spec.map_auto.resolution = !fixed && !request.map().has_resolution();
-  spec.map_auto.max_range = !fixed && !request.map().has_max_range();
+  spec.map_auto =
+      settings::MapAutoFromSettings(rpc::SettingsFromProto(request.config(), request.map()));
   return spec;
 }
 
 v1::ChosenSettings ChosenSettingsToProto(const BoIcpConfig& config, const MapBuildSettings& map,
                                          const std::vector<std::string>& auto_fields) {
   v1::ChosenSettings out;
-  v1::RegistrationConfig& c = *out.mutable_config();
-  c.set_preset(config.preset);
-  c.set_mode(SearchModeName(config.mode));
-  c.set_voxel(config.voxel);
-  c.set_random_samples(config.random_samples);
-  c.set_iterations(config.iterations);
-  *c.mutable_rotation_bounds() = PointToProto(config.rotation_bounds);
-  *c.mutable_translation_bounds() = PointToProto(config.translation_bounds);
-  c.set_seed(config.seed);
-  c.set_evaluation_points(static_cast<uint32_t>(config.evaluation_points));
-  c.set_refine_voxel(config.EffectiveRefineVoxel());
-  c.set_max_correspondence(config.EffectiveMaxCorrespondence());
-  c.set_min_range(config.min_range);
-  c.set_max_range(config.max_range);
-  c.set_no_retry(!config.retry_when_doubtful);
+  *out.mutable_config() = rpc::RegistrationConfigToProto(settings::SettingsFromConfig(config));
   out.set_map_resolution(map.occupancy.resolution);
   out.set_map_max_range(map.occupancy.max_range);
   for (const std::string& field : auto_fields) out.add_auto_fields(field);

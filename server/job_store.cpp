@@ -5,7 +5,7 @@
 #include <set>
 
 #include "boicp/util/types.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 
 namespace boicp::server {
 namespace {

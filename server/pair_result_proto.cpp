@@ -1,6 +1,6 @@
 #include "pair_result_proto.hpp"
 
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 
 namespace boicp::server {
 

@@ -11,7 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "sha256.hpp"
+#include "rpc_names.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {

@@ -4,7 +4,7 @@
 
 #include "export_reactor.hpp"
 #include "job_outputs.hpp"
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 #include "service_error.hpp"
 #include "upload_reactor.hpp"
 

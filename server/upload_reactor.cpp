@@ -6,7 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 #include "scan_integrity.hpp"
 #include "service.hpp"
 #include "service_error.hpp"

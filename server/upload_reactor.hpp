@@ -13,7 +13,7 @@
 #include <grpcpp/support/server_callback.h>
 
 #include "boicp/v1/map_builder.pb.h"
-#include "sha256.hpp"
+#include "rpc_names.hpp"
 #include "upload_budget.hpp"
 
 namespace boicp::server {

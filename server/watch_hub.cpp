@@ -3,7 +3,7 @@
 #include <deque>
 #include <vector>
 
-#include "proto_convert.hpp"
+#include "rpc_names.hpp"
 
 namespace boicp::server {
 namespace {

@@ -30,8 +30,8 @@
 
 #ifdef BOICP_TEST_WITH_DAEMON
 #include "../support/files_and_processes.hpp"
+#include "boicp/rpc/map_builder_client.hpp"
 #include "daemon_process.hpp"
-#include "map_builder_client.hpp"
 #endif
 
 #ifndef BOICP_SHARED_DATA_DIR
@@ -382,7 +382,7 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
   test::DaemonProcess daemon(
       {"--data-dir", (dir_ / "daemon").string(), "--workers", "2", "--registration-threads", "1"},
       (dir_ / "daemon.log").string());
-  client::MapBuilderClient client(client::Connect({daemon.address(), "", "", "", "", 4 << 20}));
+  rpc::MapBuilderClient client(rpc::Connect({daemon.address(), "", "", "", "", 4 << 20}));
   v1::SubmitBatchRequest request;
   for (size_t i = 0; i < truth_.size(); ++i) {
     char name[32];

@@ -25,9 +25,9 @@
 #include <open3d/io/ImageIO.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/demo_sequence.hpp"
 #include "../support/files_and_processes.hpp"
 #include "daemon_process.hpp"
-#include "demo_sequence.hpp"
 
 namespace {
 using boicp::test::HasStagingFile;
@@ -99,7 +99,7 @@ class RemoteCli : public ::testing::Test {
     fs::create_directories(folder);
     std::vector<boicp::Transform> truth;
     int index = 0;
-    for (const auto& scan : boicp::client::MakeDemoSequence(n, seed)) {
+    for (const auto& scan : boicp::test::MakeDemoSequence(n, seed)) {
       char name[32];
       std::snprintf(name, sizeof name, "%06d.bin", index++);
       std::ofstream(folder / name, std::ios::binary) << scan.kitti_bytes;

@@ -14,8 +14,8 @@
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <google/protobuf/util/delimited_message_util.h>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "job_spec.hpp"
-#include "proto_convert.hpp"
 
 namespace {
 
@@ -48,7 +48,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (v1::ScanMetadata& metadata : scans) {
     if (!ParseDelimitedFromZeroCopyStream(&metadata, &stream, nullptr)) metadata.Clear();
     try {
-      boicp::server::ValidateScanMetadata(metadata);
+      boicp::rpc::ValidateScanMetadata(metadata);
     } catch (const boicp::InputError&) {
     }
   }

@@ -5,8 +5,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "../support/demo_sequence.hpp"
 #include "boicp/mapping/map_pairs.hpp"
-#include "demo_sequence.hpp"
 
 namespace boicp::load {
 
@@ -31,7 +31,7 @@ std::vector<std::string> BatchScans::Make(int count, int points, uint64_t seed) 
     Points subset;
     std::sample(drive_[i].points.begin(), drive_[i].points.end(), std::back_inserter(subset),
                 static_cast<size_t>(points), rng);
-    scans.push_back(client::EncodeKittiBin(subset));
+    scans.push_back(test::EncodeKittiBin(subset));
   }
   return scans;
 }

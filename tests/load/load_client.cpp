@@ -4,8 +4,8 @@
 #include <random>
 #include <thread>
 
-#include "health_check.hpp"
-#include "map_builder_client.hpp"
+#include "boicp/rpc/health_check.hpp"
+#include "boicp/rpc/map_builder_client.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::load {
@@ -22,9 +22,9 @@ bool IsFinal(v1::JobState state) {
 }
 
 std::shared_ptr<grpc::Channel> Channel(const std::string& address) {
-  client::ConnectOptions options;
+  rpc::ConnectOptions options;
   options.address = address;
-  return client::Connect(options);
+  return rpc::Connect(options);
 }
 
 // Thrown to end the client after an unexpected error was recorded.
@@ -59,14 +59,13 @@ class LoadClient {
   // recorded and stops the client.
   template <typename Call>
   auto Timed(const char* rpc, Call&& call,
-             const std::function<bool(const client::RpcError&)>& expected = {})
-      -> decltype(call()) {
+             const std::function<bool(const rpc::RpcError&)>& expected = {}) -> decltype(call()) {
     const auto start = Clock::now();
     try {
       auto result = call();
       Record(rpc, start);
       return result;
-    } catch (const client::RpcError& e) {
+    } catch (const rpc::RpcError& e) {
       if (expected && expected(e)) {
         Record(rpc, start);
         throw;
@@ -110,14 +109,14 @@ class LoadClient {
 
   // SubmitBatch, retried while the daemon's queue is full.
   v1::Job Submit(const v1::SubmitBatchRequest& request) {
-    const auto queue_full = [](const client::RpcError& e) {
+    const auto queue_full = [](const rpc::RpcError& e) {
       return e.code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
     };
     while (true) {
       try {
         return Timed(
             "SubmitBatch", [&] { return client_.Submit(request); }, queue_full);
-      } catch (const client::RpcError&) {
+      } catch (const rpc::RpcError&) {
         ++totals_.submits_rejected;
         if (Clock::now() >= plan_.give_up_at) Fail("SubmitBatch", "queue full until give-up");
         Pause();
@@ -135,7 +134,7 @@ class LoadClient {
       context.set_deadline(std::chrono::system_clock::now() + kCallTimeout);
       v1::FindScansResponse response;
       const grpc::Status status = client_.stub().FindScans(&context, find, &response);
-      if (!status.ok()) throw client::RpcError("FindScans", status);
+      if (!status.ok()) throw rpc::RpcError("FindScans", status);
       return response;
     });
     if (found.missing_size() > 0) Fail("FindScans", "uploaded scan missing: " + found.missing(0));
@@ -157,10 +156,10 @@ class LoadClient {
     do {
       Pause();
       job = Timed("GetJob", [&] { return client_.GetJob(job_id); });
-      const client::ServingStatus health =
-          Timed("Health", [&] { return client::CheckHealth(channel_, kCallTimeout); });
-      if (health != client::ServingStatus::kServing) {
-        Fail("Health", "status " + client::ServingStatusName(health));
+      const rpc::ServingStatus health =
+          Timed("Health", [&] { return rpc::CheckHealth(channel_, kCallTimeout); });
+      if (health != rpc::ServingStatus::kServing) {
+        Fail("Health", "status " + rpc::ServingStatusName(health));
       }
       Timed("ListJobs", [&] { return client_.ListJobs(kListPageSize); });
     } while (!IsFinal(job.state()) && Clock::now() < plan_.give_up_at);
@@ -196,7 +195,7 @@ class LoadClient {
   const LoadOptions& options_;
   const BatchScans& scans_;
   std::shared_ptr<grpc::Channel> channel_;
-  client::MapBuilderClient client_;
+  rpc::MapBuilderClient client_;
   std::mt19937_64 rng_;
   std::uniform_real_distribution<double> pause_ms_;
   int open_jobs_ = 0;

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <thread>
 
-#include "demo_sequence.hpp"
+#include "../support/demo_sequence.hpp"
 
 namespace boicp::test {
 
@@ -35,7 +35,7 @@ v1::SubmitBatchRequest SlowBatch(const std::vector<std::string>& scan_ids) {
   return request;
 }
 
-grpc::Status RawUpload(client::MapBuilderClient& client, const v1::ScanMetadata& metadata,
+grpc::Status RawUpload(rpc::MapBuilderClient& client, const v1::ScanMetadata& metadata,
                        const std::vector<std::string>& chunks, const std::string& token) {
   grpc::ClientContext context;
   if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
@@ -60,7 +60,7 @@ v1::ScanMetadata Meta(v1::ScanFormat format, size_t size) {
   return metadata;
 }
 
-std::vector<std::string> MissingScans(client::MapBuilderClient& client,
+std::vector<std::string> MissingScans(rpc::MapBuilderClient& client,
                                       const std::vector<std::string>& ids) {
   grpc::ClientContext context;
   client.Authorize(context);
@@ -96,16 +96,16 @@ void ServerTest::StartDaemon(const std::vector<std::string>& args) {
       all, (dir_ / ("boicpd." + std::to_string(starts_++) + ".log")).string());
 }
 
-client::MapBuilderClient ServerTest::Client(const std::string& token) const {
-  client::ConnectOptions options;
+rpc::MapBuilderClient ServerTest::Client(const std::string& token) const {
+  rpc::ConnectOptions options;
   options.address = daemon_->address();
-  return client::MapBuilderClient(client::Connect(options), token);
+  return rpc::MapBuilderClient(rpc::Connect(options), token);
 }
 
-std::vector<std::string> ServerTest::UploadDrive(client::MapBuilderClient& client, int n,
+std::vector<std::string> ServerTest::UploadDrive(rpc::MapBuilderClient& client, int n,
                                                  uint64_t seed, std::vector<Transform>* truth) {
   std::vector<std::string> ids;
-  for (const auto& scan : client::MakeDemoSequence(n, seed)) {
+  for (const auto& scan : test::MakeDemoSequence(n, seed)) {
     v1::ScanMetadata metadata;
     metadata.set_format(v1::SCAN_FORMAT_KITTI_BIN);
     ids.push_back(client.Upload(scan.kitti_bytes, metadata).scan_id());
@@ -114,7 +114,7 @@ std::vector<std::string> ServerTest::UploadDrive(client::MapBuilderClient& clien
   return ids;
 }
 
-v1::Job ServerTest::PollJob(client::MapBuilderClient& client, const std::string& job_id,
+v1::Job ServerTest::PollJob(rpc::MapBuilderClient& client, const std::string& job_id,
                             const std::function<bool(const v1::Job&)>& done, double timeout_s) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   v1::Job job = client.GetJob(job_id);

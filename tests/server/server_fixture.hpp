@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/rpc/map_builder_client.hpp"
 #include "boicp/util/types.hpp"
 #include "daemon_process.hpp"
-#include "map_builder_client.hpp"
 
 namespace boicp::test {
 
@@ -28,13 +28,13 @@ v1::SubmitBatchRequest SlowBatch(const std::vector<std::string>& scan_ids);
 
 /// Uploads raw messages: `metadata`, then `chunks` (stopping at the first
 /// refused write). Returns the final status.
-grpc::Status RawUpload(client::MapBuilderClient& client, const v1::ScanMetadata& metadata,
+grpc::Status RawUpload(rpc::MapBuilderClient& client, const v1::ScanMetadata& metadata,
                        const std::vector<std::string>& chunks, const std::string& token = "");
 
 v1::ScanMetadata Meta(v1::ScanFormat format, size_t size);
 
 /// The ids among `ids` that FindScans reports missing.
-std::vector<std::string> MissingScans(client::MapBuilderClient& client,
+std::vector<std::string> MissingScans(rpc::MapBuilderClient& client,
                                       const std::vector<std::string>& ids);
 
 /// How a client call ended: OK when it returned, else the RpcError's code and
@@ -43,7 +43,7 @@ template <typename Call>
 grpc::Status StatusOf(Call&& call) {
   try {
     call();
-  } catch (const client::RpcError& e) {
+  } catch (const rpc::RpcError& e) {
     return grpc::Status(e.code(), e.detail());
   }
   return grpc::Status::OK;
@@ -64,15 +64,15 @@ class ServerTest : public ::testing::Test {
   void StartDaemon(const std::vector<std::string>& args = {"--workers", "2"});
   void StopDaemon() { daemon_.reset(); }
 
-  client::MapBuilderClient Client(const std::string& token = "") const;
+  rpc::MapBuilderClient Client(const std::string& token = "") const;
 
   /// Uploads a generated drive of `n` scans; returns their ids and, in
   /// `truth`, their poses.
-  std::vector<std::string> UploadDrive(client::MapBuilderClient& client, int n, uint64_t seed,
+  std::vector<std::string> UploadDrive(rpc::MapBuilderClient& client, int n, uint64_t seed,
                                        std::vector<Transform>* truth = nullptr);
 
   /// Polls GetJob every 50 ms until `done(job)` or `timeout_s`; returns the last job.
-  v1::Job PollJob(client::MapBuilderClient& client, const std::string& job_id,
+  v1::Job PollJob(rpc::MapBuilderClient& client, const std::string& job_id,
                   const std::function<bool(const v1::Job&)>& done, double timeout_s);
 
   std::filesystem::path dir_;

@@ -42,7 +42,7 @@ TEST_F(CancelAndConcurrency, CancelStopsARunningBatchWithinSecondsAndAQueuedOneA
   try {
     client.ExportToFile(running, v1::EXPORT_FORMAT_OCTOMAP_BT, (dir_ / "x.bt").string());
     ADD_FAILURE() << "export of a cancelled job succeeded";
-  } catch (const client::RpcError& e) {
+  } catch (const rpc::RpcError& e) {
     EXPECT_EQ(e.code(), grpc::StatusCode::FAILED_PRECONDITION);
   }
   EXPECT_EQ(client.Cancel(running).state(), v1::JOB_STATE_CANCELLED);

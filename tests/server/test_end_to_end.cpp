@@ -12,10 +12,10 @@
 #include <gmock/gmock.h>
 #include <octomap/OcTree.h>
 
+#include "../support/demo_sequence.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/registration/evaluation.hpp"
-#include "demo_sequence.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::test {
@@ -42,7 +42,7 @@ class EndToEnd : public ServerTest {
  protected:
   // KITTI 00, scans 0-9; the reference is pairs.csv (T_target_source, source
   // = scan i, target = scan i+1, refined by ICP; PROVENANCE.txt).
-  bool LoadKitti(client::MapBuilderClient& client, Drive& drive) {
+  bool LoadKitti(rpc::MapBuilderClient& client, Drive& drive) {
     const fs::path root = fs::path(BOICP_SHARED_DATA_DIR) / "kitti00";
     if (!fs::is_regular_file(root / "pairs.csv")) return false;
     for (int i = 0; i < 10; ++i) {
@@ -68,8 +68,8 @@ class EndToEnd : public ServerTest {
     return drive.T_next_this.size() == 9;
   }
 
-  void MakeSynthetic(client::MapBuilderClient& client, Drive& drive) {
-    const auto sequence = client::MakeDemoSequence(6, 21);
+  void MakeSynthetic(rpc::MapBuilderClient& client, Drive& drive) {
+    const auto sequence = test::MakeDemoSequence(6, 21);
     for (size_t i = 0; i < sequence.size(); ++i) {
       v1::ScanMetadata metadata;
       metadata.set_format(v1::SCAN_FORMAT_KITTI_BIN);

@@ -25,8 +25,8 @@
 
 #include <gmock/gmock.h>
 
+#include "../support/demo_sequence.hpp"
 #include "../support/files_and_processes.hpp"
-#include "demo_sequence.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::test {
@@ -110,10 +110,10 @@ class FaultInjection : public ServerTest {
  protected:
   void SetUp() override {
     ServerTest::SetUp();
-    drive_ = client::MakeDemoSequence(kScans, kDriveSeed);
+    drive_ = test::MakeDemoSequence(kScans, kDriveSeed);
   }
 
-  std::vector<std::string> UploadAll(client::MapBuilderClient& client, int count) {
+  std::vector<std::string> UploadAll(rpc::MapBuilderClient& client, int count) {
     std::vector<std::string> ids;
     for (int i = 0; i < count; ++i) {
       ids.push_back(client
@@ -124,7 +124,7 @@ class FaultInjection : public ServerTest {
     return ids;
   }
 
-  BatchOutput Collect(client::MapBuilderClient& client, const std::string& job_id) {
+  BatchOutput Collect(rpc::MapBuilderClient& client, const std::string& job_id) {
     BatchOutput out;
     out.results = client.Results(job_id);
     const fs::path bt = dir_ / "export.bt", tum = dir_ / "export.tum";
@@ -143,12 +143,12 @@ class FaultInjection : public ServerTest {
   // Streams scans[0..k) whole and part of scan k, then kills the daemon
   // mid-stream. Returns where; `cut` tells whether the upload failed, and
   // `cut_id` is scan k's id.
-  std::string KillDuringUpload(client::MapBuilderClient& client, std::mt19937_64& rng, bool* cut,
+  std::string KillDuringUpload(rpc::MapBuilderClient& client, std::mt19937_64& rng, bool* cut,
                                std::string* cut_id) {
     const int k = std::uniform_int_distribution<int>(0, kScans - 1)(rng);
     UploadAll(client, k);
     const std::string& bytes = drive_[static_cast<size_t>(k)].kitti_bytes;
-    *cut_id = client::ScanId(bytes);
+    *cut_id = rpc::ScanId(bytes);
     const size_t chunks = (bytes.size() + kUploadChunk - 1) / kUploadChunk;
     const size_t sent = std::uniform_int_distribution<size_t>(0, chunks - 1)(rng);
     grpc::ClientContext context;
@@ -172,7 +172,7 @@ class FaultInjection : public ServerTest {
 
   // Follows the job and kills the daemon when `ready(job)` first holds, after
   // `delay_s`. Returns the job as last seen before the kill.
-  v1::Job KillWhen(client::MapBuilderClient& client, const std::string& job_id,
+  v1::Job KillWhen(rpc::MapBuilderClient& client, const std::string& job_id,
                    const std::function<bool(const v1::Job&)>& ready, double delay_s) {
     v1::Job seen;
     bool killed = false;
@@ -185,14 +185,14 @@ class FaultInjection : public ServerTest {
         Kill();
         killed = true;
       });
-    } catch (const client::RpcError&) {
+    } catch (const rpc::RpcError&) {
       // The stream ends with the daemon.
     }
     if (!killed) Kill();  // the job ended first: the kill missed
     return seen;
   }
 
-  std::vector<client::GeneratedScan> drive_;
+  std::vector<test::GeneratedScan> drive_;
 };
 
 TEST_F(FaultInjection, SigkillAtRandomPointsThenRestartGivesTheUninterruptedResults) {

@@ -4,7 +4,7 @@
 
 #include <gmock/gmock.h>
 
-#include "demo_sequence.hpp"
+#include "../support/demo_sequence.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::test {
@@ -50,7 +50,7 @@ TEST_F(Limits, ScanBytes) {
 TEST_F(Limits, ScanPointsAtUploadAndAtSubmission) {
   StartDaemon({"--workers", "1"});
   auto client = Client();
-  const auto drive = client::MakeDemoSequence(3, 5);
+  const auto drive = test::MakeDemoSequence(3, 5);
   std::vector<std::string> ids;
   for (const auto& scan : drive) {
     ids.push_back(client.Upload(scan.kitti_bytes, Meta(v1::SCAN_FORMAT_KITTI_BIN, 0)).scan_id());

@@ -19,9 +19,9 @@ class ServiceExtras : public ServerTest {};
 
 TEST_F(ServiceExtras, HealthReflectionAndPagedListing) {
   StartDaemon({"--workers", "1", "--jobs", "1"});
-  client::ConnectOptions options;
+  rpc::ConnectOptions options;
   options.address = daemon_->address();
-  const auto channel = client::Connect(options);
+  const auto channel = rpc::Connect(options);
 
   {
     auto health = grpc::health::v1::Health::NewStub(channel);
@@ -49,7 +49,7 @@ TEST_F(ServiceExtras, HealthReflectionAndPagedListing) {
   }
 
   // Three jobs, cancelled at once; listed newest first, two per page.
-  client::MapBuilderClient client(channel);
+  rpc::MapBuilderClient client(channel);
   const auto ids = UploadDrive(client, 2, 91);
   std::vector<std::string> jobs;
   for (int i = 0; i < 3; ++i) {
@@ -100,7 +100,7 @@ TEST_F(ServiceExtras, UploadsEveryFormatAndDeduplicatesByContent) {
   EXPECT_EQ(client.Upload(pcd, meta(v1::SCAN_FORMAT_PCD)).num_points(), 3u);
   const v1::UploadScanResponse again = client.Upload(xyz, meta(v1::SCAN_FORMAT_XYZ));
   EXPECT_TRUE(again.already_present());
-  EXPECT_EQ(again.scan_id(), client::ScanId(xyz));
+  EXPECT_EQ(again.scan_id(), rpc::ScanId(xyz));
 
   // A depth image needs its camera; 7-Scenes stores millimetres.
   const std::string png =
@@ -122,10 +122,10 @@ TEST_F(ServiceExtras, ServesOverTls) {
   if (!MakeSelfSignedCertificate(key, cert)) GTEST_SKIP() << "openssl is not available";
   StartDaemon({"--workers", "1", "--tls-cert", cert, "--tls-key", key});
 
-  client::ConnectOptions tls;
+  rpc::ConnectOptions tls;
   tls.address = daemon_->address();
   tls.tls_ca_file = cert;
-  client::MapBuilderClient secure(client::Connect(tls));
+  rpc::MapBuilderClient secure(rpc::Connect(tls));
   EXPECT_EQ(secure
                 .Upload("1 2 3\n",
                         [] {
@@ -136,11 +136,11 @@ TEST_F(ServiceExtras, ServesOverTls) {
                 .num_points(),
             1u);
 
-  client::MapBuilderClient plain = Client();
+  rpc::MapBuilderClient plain = Client();
   try {
     plain.GetJob("job-000001");
     ADD_FAILURE() << "a plaintext call to the TLS port succeeded";
-  } catch (const client::RpcError& e) {
+  } catch (const rpc::RpcError& e) {
     EXPECT_EQ(e.code(), grpc::StatusCode::UNAVAILABLE);
   }
 }
@@ -152,11 +152,11 @@ TEST_F(ServiceExtras, TokenOverTls) {
   std::ofstream(dir_ / "token") << "s3cret-token\n";
   StartDaemon({"--workers", "1", "--tls-cert", cert, "--tls-key", key, "--auth-token-file",
                (dir_ / "token").string()});
-  client::ConnectOptions tls;
+  rpc::ConnectOptions tls;
   tls.address = daemon_->address();
   tls.tls_ca_file = cert;
-  client::MapBuilderClient anonymous(client::Connect(tls));
-  client::MapBuilderClient right(client::Connect(tls), "s3cret-token");
+  rpc::MapBuilderClient anonymous(rpc::Connect(tls));
+  rpc::MapBuilderClient right(rpc::Connect(tls), "s3cret-token");
   EXPECT_EQ(CodeOf([&] { anonymous.ListJobs(); }), grpc::StatusCode::UNAUTHENTICATED);
   EXPECT_EQ(right.ListJobs().jobs_size(), 0);
 }
@@ -175,18 +175,18 @@ TEST_F(ServiceExtras, MutualTlsRequiresAClientCertificateFromTheCa) {
   }
   StartDaemon(
       {"--workers", "1", "--tls-cert", cert, "--tls-key", key, "--tls-client-ca", client_cert});
-  client::ConnectOptions options;
+  rpc::ConnectOptions options;
   options.address = daemon_->address();
   options.tls_ca_file = cert;
-  client::MapBuilderClient without(client::Connect(options));
+  rpc::MapBuilderClient without(rpc::Connect(options));
   EXPECT_EQ(CodeOf([&] { without.ListJobs(); }), grpc::StatusCode::UNAVAILABLE);
   options.tls_cert_file = other_cert;
   options.tls_key_file = other_key;
-  client::MapBuilderClient stranger(client::Connect(options));
+  rpc::MapBuilderClient stranger(rpc::Connect(options));
   EXPECT_EQ(CodeOf([&] { stranger.ListJobs(); }), grpc::StatusCode::UNAVAILABLE);
   options.tls_cert_file = client_cert;
   options.tls_key_file = client_key;
-  client::MapBuilderClient known(client::Connect(options));
+  rpc::MapBuilderClient known(rpc::Connect(options));
   EXPECT_EQ(known.ListJobs().jobs_size(), 0);
   EXPECT_THAT(daemon_->Log(), ::testing::HasSubstr("client certificates required"));
 }

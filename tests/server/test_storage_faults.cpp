@@ -19,8 +19,8 @@
 
 #include <gmock/gmock.h>
 
+#include "../support/demo_sequence.hpp"
 #include "../support/files_and_processes.hpp"
-#include "demo_sequence.hpp"
 #include "read_only_dirs.hpp"
 #include "server_fixture.hpp"
 
@@ -99,7 +99,7 @@ class StorageFaults : public ServerTest {
 
   // A scan this test has not uploaded before.
   static std::string FreshScan(int seed) {
-    return client::MakeDemoSequence(1, 1000 + static_cast<uint64_t>(seed))[0].kitti_bytes;
+    return test::MakeDemoSequence(1, 1000 + static_cast<uint64_t>(seed))[0].kitti_bytes;
   }
 };
 
@@ -192,7 +192,7 @@ TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
       own.Watch(job_id, [&](const v1::JobEvent& e) {
         if (e.job().state() == v1::JOB_STATE_SUCCEEDED) watcher_saw_success = true;
       });
-    } catch (const client::RpcError&) {
+    } catch (const rpc::RpcError&) {
       // The stream ends with this daemon.
     }
   });

@@ -1,13 +1,33 @@
-#include "proto_convert.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Dense>
 
-#include "sha256.hpp"
+#include "boicp/rpc/sha256.hpp"
 
-namespace boicp::server {
+namespace boicp::rpc {
+namespace {
+
+// Every scan format with its API value; both directions read this table.
+constexpr std::pair<CloudFormat, v1::ScanFormat> kScanFormats[] = {
+    {CloudFormat::kKittiBin, v1::SCAN_FORMAT_KITTI_BIN},
+    {CloudFormat::kPcd, v1::SCAN_FORMAT_PCD},
+    {CloudFormat::kPly, v1::SCAN_FORMAT_PLY},
+    {CloudFormat::kXyz, v1::SCAN_FORMAT_XYZ},
+    {CloudFormat::kDepthPng, v1::SCAN_FORMAT_DEPTH_PNG},
+};
+
+v1::ScanFormat ScanFormatOf(CloudFormat format) {
+  for (const auto& [cloud, proto] : kScanFormats) {
+    if (cloud == format) return proto;
+  }
+  return v1::SCAN_FORMAT_UNSPECIFIED;
+}
+
+}  // namespace
 
 Transform TransformFromProto(const v1::Transform& proto, const std::string& field) {
   if (proto.m_size() != 16) {
@@ -53,22 +73,13 @@ Point PointFromProto(const v1::Vector3& proto, const std::string& field) {
 }
 
 CloudFormat FormatFromProto(int format) {
-  switch (format) {
-    case v1::SCAN_FORMAT_KITTI_BIN:
-      return CloudFormat::kKittiBin;
-    case v1::SCAN_FORMAT_PCD:
-      return CloudFormat::kPcd;
-    case v1::SCAN_FORMAT_PLY:
-      return CloudFormat::kPly;
-    case v1::SCAN_FORMAT_XYZ:
-      return CloudFormat::kXyz;
-    case v1::SCAN_FORMAT_DEPTH_PNG:
-      return CloudFormat::kDepthPng;
-    case v1::SCAN_FORMAT_UNSPECIFIED:
-      throw InputError("metadata.format is required (kitti_bin, pcd, ply, xyz or depth_png)");
-    default:
-      throw InputError("metadata.format: unknown scan format " + std::to_string(format));
+  if (format == v1::SCAN_FORMAT_UNSPECIFIED) {
+    throw InputError("metadata.format is required (kitti_bin, pcd, ply, xyz or depth_png)");
   }
+  for (const auto& [cloud, proto] : kScanFormats) {
+    if (proto == format) return cloud;
+  }
+  throw InputError("metadata.format: unknown scan format " + std::to_string(format));
 }
 
 LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata) {
@@ -96,6 +107,30 @@ LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata) {
     }
   }
   return options;
+}
+
+v1::ScanMetadata ScanMetadataOf(const ScanSource& scan) {
+  const CloudFormat format =
+      scan.load.format == CloudFormat::kAuto ? DetectCloudFormat(scan.path) : scan.load.format;
+  v1::ScanMetadata metadata;
+  metadata.set_format(ScanFormatOf(format));
+  if (format == CloudFormat::kDepthPng) {
+    const DepthOptions& depth = scan.load.depth;
+    if (!depth.intrinsics || !(depth.depth_scale > 0.0)) {
+      throw InputError(scan.path + ": a depth image needs intrinsics and a depth scale > 0");
+    }
+    v1::DepthCamera& camera = *metadata.mutable_depth();
+    camera.set_fx(depth.intrinsics->fx);
+    camera.set_fy(depth.intrinsics->fy);
+    camera.set_cx(depth.intrinsics->cx);
+    camera.set_cy(depth.intrinsics->cy);
+    camera.set_depth_scale(depth.depth_scale);
+    for (uint16_t value : depth.invalid_values) camera.add_invalid_values(value);
+  }
+  *metadata.mutable_sensor_origin() = PointToProto(scan.sensor_origin);
+  if (scan.prior_pose) TransformToProto(*scan.prior_pose, metadata.mutable_prior_pose());
+  if (scan.timestamp) metadata.set_timestamp(*scan.timestamp);
+  return metadata;
 }
 
 void ValidateScanMetadata(const v1::ScanMetadata& metadata) {
@@ -135,4 +170,4 @@ double NowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-}  // namespace boicp::server
+}  // namespace boicp::rpc

@@ -9,7 +9,7 @@
 
 #include <grpcpp/grpcpp.h>
 
-namespace boicp::client {
+namespace boicp::rpc {
 
 /// grpc.health.v1.HealthCheckResponse.ServingStatus.
 enum class ServingStatus { kUnknown = 0, kServing = 1, kNotServing = 2, kServiceUnknown = 3 };
@@ -22,4 +22,4 @@ std::string ServingStatusName(ServingStatus status);
 ServingStatus CheckHealth(const std::shared_ptr<grpc::Channel>& channel,
                           std::chrono::milliseconds timeout, const std::string& service = "");
 
-}  // namespace boicp::client
+}  // namespace boicp::rpc

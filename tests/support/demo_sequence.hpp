@@ -9,7 +9,7 @@
 
 #include "boicp/util/types.hpp"
 
-namespace boicp::client {
+namespace boicp::test {
 
 struct GeneratedScan {
   std::string kitti_bytes;  // the scan as a KITTI .bin (float32 x y z 0 per point)
@@ -22,4 +22,4 @@ std::vector<GeneratedScan> MakeDemoSequence(int num_scans, uint64_t seed);
 /// Encodes points as a KITTI .bin (reflectance 0).
 std::string EncodeKittiBin(const Points& points);
 
-}  // namespace boicp::client
+}  // namespace boicp::test

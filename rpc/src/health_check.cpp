@@ -1,4 +1,4 @@
-#include "health_check.hpp"
+#include "boicp/rpc/health_check.hpp"
 
 #include <condition_variable>
 #include <mutex>
@@ -7,9 +7,9 @@
 #include <google/protobuf/unknown_field_set.h>
 #include <grpcpp/generic/generic_stub.h>
 
-#include "map_builder_client.hpp"
+#include "boicp/rpc/map_builder_client.hpp"
 
-namespace boicp::client {
+namespace boicp::rpc {
 namespace {
 
 // HealthCheckRequest is { string service = 1; }: a length-delimited field 1,
@@ -92,4 +92,4 @@ ServingStatus CheckHealth(const std::shared_ptr<grpc::Channel>& channel,
   return DecodeStatus(ToString(response));
 }
 
-}  // namespace boicp::client
+}  // namespace boicp::rpc

@@ -1,10 +1,10 @@
-#include "sha256.hpp"
+#include "boicp/rpc/sha256.hpp"
 
 #include <openssl/evp.h>
 
 #include <stdexcept>
 
-namespace boicp::server {
+namespace boicp::rpc {
 
 struct Sha256::Context {
   EVP_MD_CTX* ctx = nullptr;
@@ -49,4 +49,4 @@ bool IsSha256Hex(const std::string& text) {
   return true;
 }
 
-}  // namespace boicp::server
+}  // namespace boicp::rpc

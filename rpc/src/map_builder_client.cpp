@@ -1,13 +1,13 @@
-#include "map_builder_client.hpp"
+#include "boicp/rpc/map_builder_client.hpp"
 
 #include <fstream>
 #include <sstream>
 #include <tuple>
 #include <utility>
 
-#include "sha256.hpp"
+#include "boicp/rpc/sha256.hpp"
 
-namespace boicp::client {
+namespace boicp::rpc {
 namespace {
 
 std::string ReadAll(const std::string& path) {
@@ -202,9 +202,9 @@ uint64_t MapBuilderClient::ExportToFile(const std::string& job_id, v1::ExportFor
 }
 
 std::string ScanId(const std::string& bytes) {
-  server::Sha256 hash;
+  Sha256 hash;
   hash.Update(bytes.data(), bytes.size());
   return hash.HexDigest();
 }
 
-}  // namespace boicp::client
+}  // namespace boicp::rpc

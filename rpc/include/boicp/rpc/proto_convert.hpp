@@ -1,15 +1,16 @@
 #pragma once
-// Conversions between the boicp.v1 messages and core types, with the
-// validation of what a client sent (every failure is an InputError naming
-// the field).
+// Conversions between the boicp.v1 messages and core types, for the daemon
+// and its clients alike, with the validation of what the other side sent
+// (every failure is an InputError naming the field).
 
 #include <string>
 
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/mapping/map_assembly.hpp"
 #include "boicp/util/types.hpp"
 #include "boicp/v1/map_builder.pb.h"
 
-namespace boicp::server {
+namespace boicp::rpc {
 
 namespace v1 = ::boicp::v1;
 
@@ -29,16 +30,22 @@ CloudFormat FormatFromProto(int format);
 /// when a depth image lacks intrinsics or scale.
 LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata);
 
+/// The upload metadata of a scan: format (explicit, else from the extension),
+/// depth camera, sensor origin, prior pose T_world_scan and timestamp. Throws
+/// InputError naming the file when a depth image lacks intrinsics or scale.
+v1::ScanMetadata ScanMetadataOf(const ScanSource& scan);
+
 /// Every check UploadScan makes on its metadata message before any byte
 /// arrives: format and depth camera, sensor origin, prior pose, and the
 /// optional sha256 (64 lowercase hex digits). Throws InputError naming the field.
 void ValidateScanMetadata(const v1::ScanMetadata& metadata);
 
+/// True for SUCCEEDED, FAILED and CANCELLED.
 bool IsTerminal(v1::JobState state);
-/// "queued", "running", "succeeded", "failed", "cancelled".
+/// "queued", "running", "succeeded", "failed", "cancelled" ("unspecified" otherwise).
 std::string JobStateName(v1::JobState state);
 
 /// Seconds since the Unix epoch, for the *_at fields.
 double NowSeconds();
 
-}  // namespace boicp::server
+}  // namespace boicp::rpc

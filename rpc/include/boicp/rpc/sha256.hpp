@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-namespace boicp::server {
+namespace boicp::rpc {
 
 class Sha256 {
  public:
@@ -26,4 +26,4 @@ class Sha256 {
 /// True for exactly 64 lowercase hex digits, the form of every scan id.
 bool IsSha256Hex(const std::string& text);
 
-}  // namespace boicp::server
+}  // namespace boicp::rpc

@@ -4,7 +4,7 @@
 
 #include "boicp/io/synthetic_scene.hpp"
 
-namespace boicp::client {
+namespace boicp::test {
 
 std::string EncodeKittiBin(const Points& points) {
   std::string bytes;
@@ -33,4 +33,4 @@ std::vector<GeneratedScan> MakeDemoSequence(int num_scans, uint64_t seed) {
   return scans;
 }
 
-}  // namespace boicp::client
+}  // namespace boicp::test

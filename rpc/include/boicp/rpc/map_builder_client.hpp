@@ -14,7 +14,7 @@
 
 #include "boicp/v1/map_builder.grpc.pb.h"
 
-namespace boicp::client {
+namespace boicp::rpc {
 
 namespace v1 = ::boicp::v1;
 
@@ -92,4 +92,4 @@ class MapBuilderClient {
 /// Lowercase hex SHA-256 of `bytes`, the scan id the daemon will assign.
 std::string ScanId(const std::string& bytes);
 
-}  // namespace boicp::client
+}  // namespace boicp::rpc

@@ -1,0 +1,133 @@
+#include "boicp/settings/setting_schema.hpp"
+
+namespace boicp::settings {
+namespace {
+
+using RS = RequestedSettings;
+using C = BoIcpConfig;
+
+constexpr unsigned kEveryFrontEnd = kRegister | kMap | kSubmit;
+constexpr unsigned kMapFrontEnds = kMap | kSubmit;
+
+constexpr const char* kNotInApi =
+    "Not in the API (RegistrationConfig), so map and submit, whose runs must agree with the "
+    "daemon's, leave it to the preset; only register takes it.";
+constexpr const char* kNoMapInRegister = "register aligns one pair and builds no map.";
+constexpr const char* kSensorModelNotLocal =
+    "register builds no map, and boicp map fuses with the default sensor model and writes no "
+    "merged PLY.";
+
+std::vector<SettingField> BuildSchema() {
+  const ProtoMessage kReg = ProtoMessage::kRegistrationConfig;
+  const ProtoMessage kMapMsg = ProtoMessage::kMapSettings;
+  const ProtoMessage kNone = ProtoMessage::kNone;
+  return {
+      {"preset", "--config", nullptr, "config", kReg, "preset", kEveryFrontEnd,
+       "BO-ICP preset A, B or C (the paper's)", nullptr, PlainBinding<std::string>{&RS::preset}},
+      {"mode", "--mode", nullptr, "mode", kReg, "mode", kEveryFrontEnd,
+       "nested (rotation then translation) or 6dof", nullptr, PlainBinding<std::string>{&RS::mode}},
+      {"seed", "--seed", nullptr, "seed", kReg, "seed", kEveryFrontEnd,
+       "Seed of every random choice; each pair's seed derives from it", nullptr,
+       PlainBinding<uint64_t>{&RS::seed}},
+      {"fixed_settings", "--fixed-settings", nullptr, "fixed_settings", kReg, "fixed_settings",
+       kEveryFrontEnd,
+       "The preset's fixed voxel, bounds and map settings instead of choosing them from the scans",
+       nullptr, PlainBinding<bool>{&RS::fixed_settings}},
+      {"no_retry", "--no-retry", nullptr, "no_retry", kReg, "no_retry", kEveryFrontEnd | kBench,
+       "Never search a doubtful pair again", nullptr, PlainBinding<bool>{&RS::no_retry}},
+      {"voxel", "--voxel", nullptr, "voxel", kReg, "voxel", kEveryFrontEnd | kBench,
+       "Search voxel (metres); default: from the scans", nullptr,
+       OptionalBinding<double>{&RS::voxel, &C::voxel}},
+      {"random_samples", "--random-samples", nullptr, "random_samples", kReg, "random_samples",
+       kEveryFrontEnd, "N_r: space-filling samples per search stage; default: the preset's",
+       nullptr, OptionalBinding<int>{&RS::random_samples, &C::random_samples}},
+      {"iterations", "--iterations", nullptr, "iterations", kReg, "iterations", kEveryFrontEnd,
+       "N: BO iterations per search stage; default: the preset's", nullptr,
+       OptionalBinding<int>{&RS::iterations, &C::iterations}},
+      {"rotation_bounds", "--rotation-bounds", nullptr, "rotation_bounds", kReg, "rotation_bounds",
+       kEveryFrontEnd | kBench,
+       "Half-widths roll,pitch,yaw (radians, or pi); default: from the sensor", nullptr,
+       OptionalBinding<Eigen::Vector3d>{&RS::rotation_bounds, &C::rotation_bounds}},
+      {"translation_bounds", "--translation-bounds", nullptr, "translation_bounds", kReg,
+       "translation_bounds", kEveryFrontEnd | kBench,
+       "Half-widths x,y,z (metres); default: from the scans", nullptr,
+       OptionalBinding<Eigen::Vector3d>{&RS::translation_bounds, &C::translation_bounds}},
+      {"evaluation_points", "--evaluation-points", nullptr, "evaluation_points", kReg,
+       "evaluation_points", kEveryFrontEnd, "Source points each evaluation uses (0 = all)", nullptr,
+       OptionalBinding<uint64_t>{&RS::evaluation_points, &C::evaluation_points}},
+      {"refine_voxel", "--refine-voxel", nullptr, "refine_voxel", kReg, "refine_voxel",
+       kEveryFrontEnd, "Finest voxel of the final ICP (metres); default: from the scans", nullptr,
+       OptionalBinding<double>{&RS::refine_voxel, &C::refine_voxel, &C::EffectiveRefineVoxel}},
+      {"max_correspondence", "--max-correspondence", nullptr, "max_correspondence", kReg,
+       "max_correspondence", kEveryFrontEnd,
+       "ICP correspondence gate during the search (metres); default 3 x voxel", nullptr,
+       OptionalBinding<double>{&RS::max_correspondence, &C::max_correspondence_distance,
+                               &C::EffectiveMaxCorrespondence}},
+      {"min_range", "--min-range", nullptr, "min_range", kReg, "min_range", kEveryFrontEnd,
+       "Drop scan points closer to the sensor than this (metres)", nullptr,
+       OptionalBinding<double>{&RS::min_range, &C::min_range}},
+      // --max-range of map and submit is the OctoMap ray cut.
+      {"scan_max_range", "--max-range", "--scan-max-range", "scan_max_range", kReg, "max_range",
+       kEveryFrontEnd, "Drop scan points farther from the sensor than this (metres; 0 = none)",
+       nullptr, OptionalBinding<double>{&RS::scan_max_range, &C::max_range}},
+      {"objective_truncation", "--objective-truncation", nullptr, "objective_truncation", kNone, "",
+       kRegister, "Clipping distance of the search objective (metres); default 1.5 x voxel",
+       kNotInApi,
+       OptionalBinding<double>{&RS::objective_truncation, &C::objective_truncation,
+                               &C::EffectiveTruncation}},
+      {"icp_iterations", "--icp-iterations", nullptr, "icp_iterations", kNone, "", kRegister,
+       "ICP iterations per evaluation", kNotInApi,
+       OptionalBinding<int>{&RS::icp_iterations, &C::icp_max_iterations}},
+      {"coarse_icp_points", "--coarse-icp-points", nullptr, "coarse_icp_points", kNone, "",
+       kRegister, "Points each evaluation's ICP starts on before it finishes on all (0 = all)",
+       kNotInApi, OptionalBinding<uint64_t>{&RS::coarse_icp_points, &C::coarse_icp_points}},
+      {"threads", "--threads", nullptr, "threads", kNone, "", kRegister,
+       "Threads for the search and the refinement (the answer does not depend on it)",
+       "Map and the daemon run one registration thread per pair and spread pairs over threads "
+       "(map --threads, boicpd --registration-threads).",
+       OptionalBinding<int>{&RS::threads, &C::threads}},
+
+      {"resolution", "--resolution", nullptr, "resolution", kMapMsg, "resolution", kMapFrontEnds,
+       "OctoMap leaf size (metres); default: from the scans", kNoMapInRegister,
+       OptionalBinding<double>{&RS::resolution}},
+      {"max_range", "--max-range", nullptr, "max_range", kMapMsg, "max_range", kMapFrontEnds,
+       "OctoMap ray length (metres), 0 = no limit; default: from the scans", kNoMapInRegister,
+       OptionalBinding<double>{&RS::max_range}},
+      {"prob_hit", "--prob-hit", nullptr, "prob_hit", kMapMsg, "sensor_model.prob_hit", kSubmit,
+       "OctoMap hit probability, in (0.5, 1); default 0.7", kSensorModelNotLocal,
+       OptionalBinding<double>{&RS::prob_hit}},
+      {"prob_miss", "--prob-miss", nullptr, "prob_miss", kMapMsg, "sensor_model.prob_miss", kSubmit,
+       "OctoMap miss probability, in (0, 0.5); default 0.4", kSensorModelNotLocal,
+       OptionalBinding<double>{&RS::prob_miss}},
+      {"clamp_min", "--clamp-min", nullptr, "clamp_min", kMapMsg, "sensor_model.clamp_min", kSubmit,
+       "OctoMap lower clamping probability; default 0.12", kSensorModelNotLocal,
+       OptionalBinding<double>{&RS::clamp_min}},
+      {"clamp_max", "--clamp-max", nullptr, "clamp_max", kMapMsg, "sensor_model.clamp_max", kSubmit,
+       "OctoMap upper clamping probability; default 0.97", kSensorModelNotLocal,
+       OptionalBinding<double>{&RS::clamp_max}},
+      {"cloud_voxel", "--cloud-voxel", nullptr, "cloud_voxel", kMapMsg, "cloud_voxel", kSubmit,
+       "Voxel of the exported merged PLY (metres); default: the resolution", kSensorModelNotLocal,
+       OptionalBinding<double>{&RS::cloud_voxel}},
+  };
+}
+
+}  // namespace
+
+const std::vector<SettingField>& SettingSchema() {
+  static const std::vector<SettingField> schema = BuildSchema();
+  return schema;
+}
+
+const SettingField* FindSetting(const std::string& name) {
+  for (const SettingField& field : SettingSchema()) {
+    if (name == field.name) return &field;
+  }
+  return nullptr;
+}
+
+const char* FlagFor(const SettingField& field, Frontend frontend) {
+  const bool map_side = frontend == kMap || frontend == kSubmit;
+  return map_side && field.map_flag != nullptr ? field.map_flag : field.flag;
+}
+
+}  // namespace boicp::settings
