@@ -4,10 +4,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "boicp/mapping/map_preview.hpp"
+#include "boicp/settings/requested_settings.hpp"
 #include "boicp/settings/setting_schema.hpp"
 #include "boicp/settings/settings_json.hpp"
-#include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 #include "json_output.hpp"
 
@@ -114,15 +113,12 @@ LocalRun PrepareRun(const MapSettings& settings) {
   run.config = BuildConfig(settings);
   // Unset map settings keep OccupancySettings' fixed defaults until
   // ChooseRunSettings replaces them.
-  if (settings.resolution) run.map.occupancy.resolution = *settings.resolution;
-  if (settings.max_range) run.map.occupancy.max_range = *settings.max_range;
-  run.map_auto.resolution = !settings.fixed_settings && !settings.resolution;
-  run.map_auto.max_range = !settings.fixed_settings && !settings.max_range;
   try {
-    ValidateOccupancySettings(run.map.occupancy);
+    run.map = boicp::settings::MapBuildFromSettings(settings);
   } catch (const InputError& e) {
     throw InputError(std::string("map settings: ") + e.what());
   }
+  run.map_auto = boicp::settings::MapAutoFromSettings(settings);
   run.folder = ReadScanFolder(settings.path, FolderOptions(settings));
   const int n = static_cast<int>(run.folder.scans.size());
   if (n < 2) {

@@ -13,9 +13,8 @@ constexpr const char* kNotInApi =
     "Not in the API (RegistrationConfig), so map and submit, whose runs must agree with the "
     "daemon's, leave it to the preset; only register takes it.";
 constexpr const char* kNoMapInRegister = "register aligns one pair and builds no map.";
-constexpr const char* kSensorModelNotLocal =
-    "register builds no map, and boicp map fuses with the default sensor model and writes no "
-    "merged PLY.";
+constexpr const char* kNoMergedCloudLocally =
+    "register builds no map, and boicp map writes no merged PLY.";
 
 std::vector<SettingField> BuildSchema() {
   const ProtoMessage kReg = ProtoMessage::kRegistrationConfig;
@@ -93,20 +92,20 @@ std::vector<SettingField> BuildSchema() {
       {"max_range", "--max-range", nullptr, "max_range", kMapMsg, "max_range", kMapFrontEnds,
        "OctoMap ray length (metres), 0 = no limit; default: from the scans", kNoMapInRegister,
        OptionalBinding<double>{&RS::max_range}},
-      {"prob_hit", "--prob-hit", nullptr, "prob_hit", kMapMsg, "sensor_model.prob_hit", kSubmit,
-       "OctoMap hit probability, in (0.5, 1); default 0.7", kSensorModelNotLocal,
+      {"prob_hit", "--prob-hit", nullptr, "prob_hit", kMapMsg, "sensor_model.prob_hit",
+       kMapFrontEnds, "OctoMap hit probability, in (0.5, 1); default 0.7", kNoMapInRegister,
        OptionalBinding<double>{&RS::prob_hit}},
-      {"prob_miss", "--prob-miss", nullptr, "prob_miss", kMapMsg, "sensor_model.prob_miss", kSubmit,
-       "OctoMap miss probability, in (0, 0.5); default 0.4", kSensorModelNotLocal,
+      {"prob_miss", "--prob-miss", nullptr, "prob_miss", kMapMsg, "sensor_model.prob_miss",
+       kMapFrontEnds, "OctoMap miss probability, in (0, 0.5); default 0.4", kNoMapInRegister,
        OptionalBinding<double>{&RS::prob_miss}},
-      {"clamp_min", "--clamp-min", nullptr, "clamp_min", kMapMsg, "sensor_model.clamp_min", kSubmit,
-       "OctoMap lower clamping probability; default 0.12", kSensorModelNotLocal,
+      {"clamp_min", "--clamp-min", nullptr, "clamp_min", kMapMsg, "sensor_model.clamp_min",
+       kMapFrontEnds, "OctoMap lower clamping probability; default 0.12", kNoMapInRegister,
        OptionalBinding<double>{&RS::clamp_min}},
-      {"clamp_max", "--clamp-max", nullptr, "clamp_max", kMapMsg, "sensor_model.clamp_max", kSubmit,
-       "OctoMap upper clamping probability; default 0.97", kSensorModelNotLocal,
+      {"clamp_max", "--clamp-max", nullptr, "clamp_max", kMapMsg, "sensor_model.clamp_max",
+       kMapFrontEnds, "OctoMap upper clamping probability; default 0.97", kNoMapInRegister,
        OptionalBinding<double>{&RS::clamp_max}},
       {"cloud_voxel", "--cloud-voxel", nullptr, "cloud_voxel", kMapMsg, "cloud_voxel", kSubmit,
-       "Voxel of the exported merged PLY (metres); default: the resolution", kSensorModelNotLocal,
+       "Voxel of the exported merged PLY (metres); default: the resolution", kNoMergedCloudLocally,
        OptionalBinding<double>{&RS::cloud_voxel}},
   };
 }
