@@ -404,6 +404,7 @@ class JobRun {
         MaybePublishProgress();
       }
     };
+    spec_.map.fusion_threads = ctx_.pool.size();  // one per --workers: the pairs are done
     const FusionSummary summary =
         FuseScans(spec_.scans, estimate.poses, spec_.map, JobOutputPaths(dir), callbacks);
     RequireOutputsWritten(JobOutputPaths(dir));

@@ -1,18 +1,135 @@
 #include "boicp/mapping/occupancy_map.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <vector>
 
 #include <octomap/OcTree.h>
 
+#include "boicp/util/parallel_for.hpp"
+
 namespace boicp {
 namespace {
+
+using octomap::KeySet;
+using octomap::OcTreeKey;
+using octomap::point3d;
 
 void Require(bool ok, const std::string& message) {
   if (!ok) throw InputError("map settings: " + message);
 }
 
+// Which of `shards` sets a cell belongs to. The cell sets are split by key so
+// that each split is merged on its own thread; OctoMap's KeyHash is too
+// regular in its low bits to split on, so the coordinates are mixed first.
+size_t ShardOf(const OcTreeKey& key, size_t shards) {
+  const uint64_t mixed = (static_cast<uint64_t>(key[0]) * 0x9E3779B97F4A7C15ull) ^
+                         (static_cast<uint64_t>(key[1]) * 0xC2B2AE3D27D4EB4Full) ^
+                         (static_cast<uint64_t>(key[2]) * 0x165667B19E3779F9ull);
+  return static_cast<size_t>(mixed >> 32) % shards;
+}
+
+// Free and occupied cells, each split into shards by ShardOf.
+struct ShardedCells {
+  explicit ShardedCells(size_t shards) : free(shards), occupied(shards) {}
+  std::vector<KeySet> free, occupied;
+};
+
+// The scan in the map frame, in OctoMap's single precision.
+octomap::Pointcloud ToMapFrame(const Points& points, const Transform& T_map_scan) {
+  const Eigen::Matrix3d R = T_map_scan.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_map_scan.topRightCorner<3, 1>();
+  octomap::Pointcloud cloud;
+  cloud.reserve(points.size());
+  for (const Point& p : points) {
+    const Point q = R * p + t;
+    cloud.push_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                    static_cast<float>(q.z()));
+  }
+  return cloud;
+}
+
+// One endpoint per leaf, at the leaf's centre: OctoMap's discretised
+// insertion (computeDiscreteUpdate), which casts one ray per leaf hit.
+std::vector<point3d> DiscretisedEndpoints(const octomap::OcTree& tree,
+                                          const octomap::Pointcloud& cloud) {
+  KeySet leaves;
+  std::vector<point3d> endpoints;
+  endpoints.reserve(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const OcTreeKey key = tree.coordToKey(cloud[i]);
+    if (leaves.insert(key).second) endpoints.push_back(tree.keyToCoord(key));
+  }
+  return endpoints;
+}
+
+// Casts the rays to endpoints [begin, end) as OctoMap's computeUpdate does
+// without a bounding box: cells along a ray are free, its endpoint occupied;
+// a ray longer than max_range (when >= 0) is cut there and marks no endpoint.
+void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints, size_t begin,
+              size_t end, const point3d& origin, double max_range, ShardedCells& cells) {
+  const size_t shards = cells.free.size();
+  octomap::KeyRay ray;
+  const auto mark_free = [&] {
+    for (const OcTreeKey& key : ray) cells.free[ShardOf(key, shards)].insert(key);
+  };
+  for (size_t i = begin; i < end; ++i) {
+    const point3d& p = endpoints[i];
+    if (max_range < 0.0 || (p - origin).norm() <= max_range) {
+      if (tree.computeRayKeys(origin, p, ray)) mark_free();
+      OcTreeKey key;
+      if (tree.coordToKeyChecked(p, key)) cells.occupied[ShardOf(key, shards)].insert(key);
+    } else {
+      const point3d direction = (p - origin).normalized();
+      const point3d cut_end = origin + direction * static_cast<float>(max_range);
+      if (tree.computeRayKeys(origin, cut_end, ray)) mark_free();
+    }
+  }
+}
+
+// Unites shard `shard` of every chunk's cells into `merged`, then drops from
+// the free cells those also occupied (OctoMap prefers occupied).
+void MergeShard(std::vector<ShardedCells>& chunks, size_t shard, ShardedCells& merged) {
+  KeySet& free = merged.free[shard];
+  KeySet& occupied = merged.occupied[shard];
+  free = std::move(chunks[0].free[shard]);
+  occupied = std::move(chunks[0].occupied[shard]);
+  for (size_t c = 1; c < chunks.size(); ++c) {
+    free.insert(chunks[c].free[shard].begin(), chunks[c].free[shard].end());
+    occupied.insert(chunks[c].occupied[shard].begin(), chunks[c].occupied[shard].end());
+    KeySet().swap(chunks[c].free[shard]);
+    KeySet().swap(chunks[c].occupied[shard]);
+  }
+  for (auto it = free.begin(); it != free.end();) {
+    it = occupied.count(*it) != 0 ? free.erase(it) : std::next(it);
+  }
+}
+
 }  // namespace
+
+struct ScanUpdate::Impl {
+  explicit Impl(size_t shards) : cells(shards) {}
+  ShardedCells cells;  // free and occupied are disjoint
+};
+
+ScanUpdate::ScanUpdate() : impl_(std::make_unique<Impl>(1)) {}
+ScanUpdate::~ScanUpdate() = default;
+ScanUpdate::ScanUpdate(ScanUpdate&&) noexcept = default;
+ScanUpdate& ScanUpdate::operator=(ScanUpdate&&) noexcept = default;
+
+size_t ScanUpdate::FreeCells() const {
+  size_t count = 0;
+  for (const KeySet& shard : impl_->cells.free) count += shard.size();
+  return count;
+}
+
+size_t ScanUpdate::OccupiedCells() const {
+  size_t count = 0;
+  for (const KeySet& shard : impl_->cells.occupied) count += shard.size();
+  return count;
+}
 
 struct OccupancyMap::Impl {
   explicit Impl(const OccupancySettings& s) : settings(s), tree(s.resolution) {
@@ -52,22 +169,43 @@ OccupancyMap::~OccupancyMap() = default;
 
 void OccupancyMap::InsertScan(const Points& points, const Transform& T_map_scan,
                               const Point& sensor_origin) {
-  const Eigen::Matrix3d R = T_map_scan.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t = T_map_scan.topRightCorner<3, 1>();
-  octomap::Pointcloud cloud;
-  cloud.reserve(points.size());
-  for (const Point& p : points) {
-    const Point q = R * p + t;
-    cloud.push_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                    static_cast<float>(q.z()));
-  }
-  const Point origin = R * sensor_origin + t;
+  ApplyUpdate(ComputeUpdate(points, T_map_scan, sensor_origin, 1));
+}
+
+ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_map_scan,
+                                       const Point& sensor_origin, int threads) const {
+  const octomap::OcTree& tree = impl_->tree;
+  const std::vector<point3d> endpoints = DiscretisedEndpoints(tree, ToMapFrame(points, T_map_scan));
+  const Point origin_d =
+      T_map_scan.topLeftCorner<3, 3>() * sensor_origin + T_map_scan.topRightCorner<3, 1>();
+  const point3d origin(static_cast<float>(origin_d.x()), static_cast<float>(origin_d.y()),
+                       static_cast<float>(origin_d.z()));
   const double max_range = impl_->settings.max_range > 0.0 ? impl_->settings.max_range : -1.0;
-  impl_->tree.insertPointCloud(
-      cloud,
-      octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
-                       static_cast<float>(origin.z())),
-      max_range, /*lazy_eval=*/true, /*discretize=*/true);
+
+  const size_t workers = static_cast<size_t>(std::max(threads, 1));
+  const size_t chunk_count = std::max<size_t>(1, std::min(workers, endpoints.size()));
+  const size_t shards = workers;
+  std::vector<ShardedCells> chunks(chunk_count, ShardedCells(shards));
+  ParallelFor(chunk_count, threads, [&](size_t c) {
+    const size_t begin = endpoints.size() * c / chunk_count;
+    const size_t end = endpoints.size() * (c + 1) / chunk_count;
+    CastRays(tree, endpoints, begin, end, origin, max_range, chunks[c]);
+  });
+
+  ScanUpdate update;
+  update.impl_ = std::make_unique<ScanUpdate::Impl>(shards);
+  ParallelFor(shards, threads, [&](size_t s) { MergeShard(chunks, s, update.impl_->cells); });
+  return update;
+}
+
+void OccupancyMap::ApplyUpdate(const ScanUpdate& update) {
+  octomap::OcTree& tree = impl_->tree;
+  for (const KeySet& shard : update.impl_->cells.free) {
+    for (const OcTreeKey& key : shard) tree.updateNode(key, false, /*lazy_eval=*/true);
+  }
+  for (const KeySet& shard : update.impl_->cells.occupied) {
+    for (const OcTreeKey& key : shard) tree.updateNode(key, true, /*lazy_eval=*/true);
+  }
   impl_->inner_dirty = true;
 }
 
