@@ -1,9 +1,11 @@
 #include "boicp/mapping/occupancy_map.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <unordered_map>
 #include <vector>
 
 #include <octomap/OcTree.h>
@@ -43,20 +45,97 @@ class FusionOcTree : public octomap::OcTree {
   }
 };
 
-// Which of `shards` sets a cell belongs to. The cell sets are split by key so
-// that each split is merged on its own thread; OctoMap's KeyHash is too
-// regular in its low bits to split on, so the coordinates are mixed first.
-size_t ShardOf(const OcTreeKey& key, size_t shards) {
-  const uint64_t mixed = (static_cast<uint64_t>(key[0]) * 0x9E3779B97F4A7C15ull) ^
-                         (static_cast<uint64_t>(key[1]) * 0xC2B2AE3D27D4EB4Full) ^
-                         (static_cast<uint64_t>(key[2]) * 0x165667B19E3779F9ull);
-  return static_cast<size_t>(mixed >> 32) % shards;
+// A set of cells as bitmaps of 16 x 16 x 16-cell blocks. A ray marks
+// millions of cells, mostly repeats near the sensor; setting a bit in the
+// block the ray is already in costs far less than a hash-set insertion, and
+// memory stays in proportion to the blocks touched.
+class CellSet {
+ public:
+  using BlockId = uint64_t;
+  using Block = std::array<uint64_t, 64>;  // 4096 bits
+
+  static BlockId BlockOf(const OcTreeKey& key) {
+    return (static_cast<BlockId>(key[0] >> 4) << 24) | (static_cast<BlockId>(key[1] >> 4) << 12) |
+           static_cast<BlockId>(key[2] >> 4);
+  }
+
+  void Insert(const OcTreeKey& key) {
+    const BlockId id = BlockOf(key);
+    if (id != last_id_ || last_ == nullptr) {
+      last_ = &blocks_[id];  // value-initialised: all bits clear
+      last_id_ = id;
+    }
+    const unsigned bit = BitOf(key);
+    (*last_)[bit >> 6] |= uint64_t{1} << (bit & 63);
+  }
+
+  void Erase(const OcTreeKey& key) {
+    const auto it = blocks_.find(BlockOf(key));
+    if (it == blocks_.end()) return;
+    const unsigned bit = BitOf(key);
+    it->second[bit >> 6] &= ~(uint64_t{1} << (bit & 63));
+  }
+
+  void UniteWith(const CellSet& other) {
+    for (const auto& [id, block] : other.blocks_) {
+      Block& mine = blocks_[id];
+      for (size_t w = 0; w < mine.size(); ++w) mine[w] |= block[w];
+    }
+    last_ = nullptr;
+  }
+
+  size_t Count() const {
+    size_t count = 0;
+    for (const auto& entry : blocks_) {
+      for (const uint64_t word : entry.second)
+        count += static_cast<size_t>(__builtin_popcountll(word));
+    }
+    return count;
+  }
+
+  template <typename Visit>
+  void ForEach(Visit visit) const {
+    for (const auto& [id, block] : blocks_) {
+      for (size_t w = 0; w < block.size(); ++w) {
+        for (uint64_t word = block[w]; word != 0; word &= word - 1) {
+          const unsigned bit =
+              static_cast<unsigned>(w * 64) + static_cast<unsigned>(__builtin_ctzll(word));
+          visit(KeyOf(id, bit));
+        }
+      }
+    }
+  }
+
+ private:
+  static unsigned BitOf(const OcTreeKey& key) {
+    return (static_cast<unsigned>(key[0] & 15) << 8) | (static_cast<unsigned>(key[1] & 15) << 4) |
+           static_cast<unsigned>(key[2] & 15);
+  }
+  static OcTreeKey KeyOf(BlockId id, unsigned bit) {
+    const auto coordinate = [&](int shift_id, int shift_bit) {
+      return static_cast<octomap::key_type>((((id >> shift_id) & 0xFFF) << 4) |
+                                            ((bit >> shift_bit) & 15));
+    };
+    return OcTreeKey(coordinate(24, 8), coordinate(12, 4), coordinate(0, 0));
+  }
+
+  std::unordered_map<BlockId, Block> blocks_;
+  BlockId last_id_ = 0;
+  Block* last_ = nullptr;  // the block of the last insertion (element pointers are stable)
+};
+
+// Which of `shards` sets a block's cells belong to, so that each shard is
+// merged on its own thread. The block id is mixed first: neighbouring
+// blocks should land in different shards.
+size_t ShardOf(CellSet::BlockId block, size_t shards) {
+  return static_cast<size_t>((block * 0x9E3779B97F4A7C15ull) >> 40) % shards;
 }
 
-// Free and occupied cells, each split into shards by ShardOf.
+// Free and occupied cells, each split into shards by the cell's block.
 struct ShardedCells {
   explicit ShardedCells(size_t shards) : free(shards), occupied(shards) {}
-  std::vector<KeySet> free, occupied;
+  std::vector<CellSet> free;
+  std::vector<KeySet> occupied;
 };
 
 // The scan in the map frame, in OctoMap's single precision.
@@ -95,14 +174,18 @@ void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints
   const size_t shards = cells.free.size();
   octomap::KeyRay ray;
   const auto mark_free = [&] {
-    for (const OcTreeKey& key : ray) cells.free[ShardOf(key, shards)].insert(key);
+    for (const OcTreeKey& key : ray) {
+      cells.free[shards == 1 ? 0 : ShardOf(CellSet::BlockOf(key), shards)].Insert(key);
+    }
   };
   for (size_t i = begin; i < end; ++i) {
     const point3d& p = endpoints[i];
     if (max_range < 0.0 || (p - origin).norm() <= max_range) {
       if (tree.computeRayKeys(origin, p, ray)) mark_free();
       OcTreeKey key;
-      if (tree.coordToKeyChecked(p, key)) cells.occupied[ShardOf(key, shards)].insert(key);
+      if (tree.coordToKeyChecked(p, key)) {
+        cells.occupied[ShardOf(CellSet::BlockOf(key), shards)].insert(key);
+      }
     } else {
       const point3d direction = (p - origin).normalized();
       const point3d cut_end = origin + direction * static_cast<float>(max_range);
@@ -114,19 +197,17 @@ void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints
 // Unites shard `shard` of every chunk's cells into `merged`, then drops from
 // the free cells those also occupied (OctoMap prefers occupied).
 void MergeShard(std::vector<ShardedCells>& chunks, size_t shard, ShardedCells& merged) {
-  KeySet& free = merged.free[shard];
+  CellSet& free = merged.free[shard];
   KeySet& occupied = merged.occupied[shard];
   free = std::move(chunks[0].free[shard]);
   occupied = std::move(chunks[0].occupied[shard]);
   for (size_t c = 1; c < chunks.size(); ++c) {
-    free.insert(chunks[c].free[shard].begin(), chunks[c].free[shard].end());
+    free.UniteWith(chunks[c].free[shard]);
     occupied.insert(chunks[c].occupied[shard].begin(), chunks[c].occupied[shard].end());
-    KeySet().swap(chunks[c].free[shard]);
+    chunks[c].free[shard] = CellSet();
     KeySet().swap(chunks[c].occupied[shard]);
   }
-  for (auto it = free.begin(); it != free.end();) {
-    it = occupied.count(*it) != 0 ? free.erase(it) : std::next(it);
-  }
+  for (const OcTreeKey& key : occupied) free.Erase(key);
 }
 
 }  // namespace
@@ -143,7 +224,7 @@ ScanUpdate& ScanUpdate::operator=(ScanUpdate&&) noexcept = default;
 
 size_t ScanUpdate::FreeCells() const {
   size_t count = 0;
-  for (const KeySet& shard : impl_->cells.free) count += shard.size();
+  for (const CellSet& shard : impl_->cells.free) count += shard.Count();
   return count;
 }
 
@@ -222,8 +303,8 @@ ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_
 
 void OccupancyMap::ApplyUpdate(const ScanUpdate& update) {
   FusionOcTree& tree = impl_->tree;
-  for (const KeySet& shard : update.impl_->cells.free) {
-    for (const OcTreeKey& key : shard) tree.Update(key, /*occupied=*/false);
+  for (const CellSet& shard : update.impl_->cells.free) {
+    shard.ForEach([&](const OcTreeKey& key) { tree.Update(key, /*occupied=*/false); });
   }
   for (const KeySet& shard : update.impl_->cells.occupied) {
     for (const OcTreeKey& key : shard) tree.Update(key, /*occupied=*/true);
