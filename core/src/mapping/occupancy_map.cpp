@@ -28,7 +28,7 @@ void Require(bool ok, const std::string& message) {
 // update's direction; otherwise it descends again to update. The second
 // descent alone gives the same tree: a clamped leaf updated the same way is
 // clamped back to the same value, and its path already exists. That saves
-// one of the two descents per cell, most of the tree update's cost.
+// one of the two descents per cell, about half of the tree update.
 class FusionOcTree : public octomap::OcTree {
  public:
   using octomap::OcTree::OcTree;
