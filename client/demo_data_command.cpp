@@ -2,11 +2,13 @@
 // with the true transform, or a generated drive with its true poses, so the
 // demo runs on a machine without real data.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <string>
 
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/synthetic_scene.hpp"
@@ -16,11 +18,15 @@
 namespace boicp::cli {
 namespace {
 
+// Each scan is about 3 MB of text; the cap keeps a typo from filling the disk.
+constexpr int kMaxDriveScans = 10000;
+
 struct DemoFlags {
   std::string out = "demo";
   uint64_t seed = 7;
   double yaw_deg = 135.0;
-  int scans = 0;  // 0: the pair; otherwise a drive of this many scans
+  int scans = 0;      // 0: the pair; otherwise a drive of this many scans
+  bool loop = false;  // the drive comes back to its start
 };
 
 void WriteTransform(const std::string& path, const Transform& T) {
@@ -32,15 +38,30 @@ void WriteTransform(const std::string& path, const Transform& T) {
   if (!file) throw InputError(path + ": cannot write");
 }
 
+// Digits of the largest scan index, at least 3, so that name order is scan order.
+int IndexDigits(int num_scans) {
+  int digits = 1;
+  for (int n = num_scans - 1; n >= 10; n /= 10) ++digits;
+  return std::max(digits, 3);
+}
+
+std::string ZeroPadded(int value, int digits) {
+  const std::string text = std::to_string(value);
+  return std::string(static_cast<size_t>(std::max(digits - static_cast<int>(text.size()), 0)),
+                     '0') +
+         text;
+}
+
 // scan_000.xyz, scan_001.xyz, ... (a folder `boicp map` and `submit` read in
-// name order) and their true poses T_world_scan in truth.kitti.
+// name order) and their true poses T_world_scan in truth.kitti. Scans are
+// generated and written one at a time, so any length fits in memory.
 void WriteDrive(const DemoFlags& f) {
+  const SyntheticDrive drive(f.scans, f.seed, f.loop);
+  const int digits = IndexDigits(f.scans);
   std::vector<Transform> poses;
-  int index = 0;
-  for (const SyntheticScan& scan : MakeSyntheticDrive(f.scans, f.seed)) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "/scan_%03d.xyz", index++);
-    WriteXyz(f.out + name, scan.points);
+  for (int i = 0; i < drive.size(); ++i) {
+    const SyntheticScan scan = drive.Scan(i);
+    WriteXyz(f.out + "/scan_" + ZeroPadded(i, digits) + ".xyz", scan.points);
     poses.push_back(scan.T_world_scan);
   }
   std::ofstream truth(f.out + "/truth.kitti");
@@ -52,9 +73,13 @@ void WriteDrive(const DemoFlags& f) {
 
 int RunDemoData(const DemoFlags& f) {
   try {
+    if (f.loop && f.scans == 0) throw InputError("--loop needs --scans N (a drive)");
     std::filesystem::create_directories(f.out);
     if (f.scans != 0) {
       if (f.scans < 2) throw InputError("--scans must be 0 (a pair) or at least 2");
+      if (f.scans > kMaxDriveScans) {
+        throw InputError("--scans must be at most " + std::to_string(kMaxDriveScans));
+      }
       WriteDrive(f);
       return kOk;
     }
@@ -86,6 +111,9 @@ CommandRunner AddDemoDataCommand(CLI::App& app) {
   app.add_option("--scans", flags->scans,
                  "Write a drive of this many scans (scan_*.xyz, truth.kitti) instead of a pair")
       ->capture_default_str();
+  app.add_flag("--loop", flags->loop,
+               "With --scans: drive out along the street and back in the other lane, ending "
+               "beside the start");
   return [flags] { return RunDemoData(*flags); };
 }
 

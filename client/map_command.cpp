@@ -147,6 +147,7 @@ int RunMap(MapFlags flags) {
     if (sharded) CheckShardManifest(run, out);
     CheckScansLoad(run.folder);
     ChooseRunSettings(run);
+    run.map.fusion_threads = flags.threads;
     std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
     PrintRunSettings(run);
     if (!sharded) return BuildMap(run, flags, start);

@@ -102,6 +102,9 @@ class JobRun : public MapProgressSink {
     batch_.scans = batch_spec_.scans;
     batch_.config = batch_spec_.config;
     batch_.map = batch_spec_.map;
+    // Fusion starts once this job's pairs are done; its ray casting takes one
+    // thread per worker (the map does not depend on the count).
+    batch_.map.fusion_threads = ctx_.pool.size();
     batch_.plan = JobPlan(batch_spec_);
     job_.set_state(v1::JOB_STATE_RUNNING);
     if (job_.started_at() == 0.0) job_.set_started_at(NowSeconds());

@@ -1,7 +1,9 @@
 #include "boicp/io/synthetic_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 namespace boicp {
 namespace {
@@ -39,7 +41,68 @@ void SamplePole(const Point& base, double radius, double height, double density,
   }
 }
 
+// The street: MakeSyntheticStreet spans x in [-40, 40] m, segment k >= 1
+// spans [40 + 80 (k - 1), 40 + 80 k].
+constexpr double kStreetEnd = 40.0;
+constexpr double kSegmentLength = 80.0;
+constexpr double kScanRange = 35.0;   // metres
+constexpr double kScanNoise = 0.02;   // metres, per coordinate
+constexpr double kScanSpacing = 2.0;  // metres along the street
+constexpr double kReturnLane = -3.0;  // metres, y of a loop's way back
+constexpr double kFirstScanX = -7.0;  // metres
+
+double SegmentStart(int segment) { return kStreetEnd + kSegmentLength * (segment - 1); }
+
+// SplitMix64's finaliser: independent-looking seeds from (seed, index).
+uint64_t MixSeed(uint64_t seed, uint64_t index) {
+  uint64_t z = seed + 0x9E3779B97F4A7C15ull * (index + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// Facade blocks of random length, height and setback with random gaps along
+// one side (side = +1 left, -1 right) of [x_begin, x_end].
+void SampleFacades(double x_begin, double x_end, double side, double density, std::mt19937_64& rng,
+                   Points& out) {
+  std::uniform_real_distribution<double> gap(0.0, 6.0), length(8.0, 25.0), setback(8.0, 10.0),
+      height(5.0, 14.0);
+  double x = x_begin + gap(rng);
+  while (x_end - x >= 3.0) {
+    const double block = std::min(length(rng), x_end - x);
+    SampleRectangle(Point(x, side * setback(rng), 0), Point(block, 0, 0), Point(0, 0, height(rng)),
+                    density, rng, out);
+    x += block + gap(rng);
+  }
+}
+
 }  // namespace
+
+Points MakeStreetSegment(uint64_t seed, int segment, double density) {
+  if (segment < 1) throw std::invalid_argument("MakeStreetSegment: segment must be >= 1");
+  std::mt19937_64 rng(MixSeed(seed, static_cast<uint64_t>(segment)));
+  const double x0 = SegmentStart(segment);
+  const double x1 = x0 + kSegmentLength;
+  Points world;
+  SampleRectangle(Point(x0, -12, 0), Point(kSegmentLength, 0, 0), Point(0, 24, 0), density / 8, rng,
+                  world);
+  SampleFacades(x0, x1, +1.0, density, rng, world);
+  SampleFacades(x0, x1, -1.0, density, rng, world);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const int cars = 2 + static_cast<int>(rng() % 3);
+  for (int c = 0; c < cars; ++c) {
+    const double x = x0 + 2.0 + 73.0 * unit(rng);
+    const double y = unit(rng) < 0.5 ? 4.8 + 0.7 * unit(rng) : -7.0 + 0.8 * unit(rng);
+    SampleBox(Point(x, y, 0),
+              Point(3.8 + 1.0 * unit(rng), 1.7 + 0.2 * unit(rng), 1.4 + 0.4 * unit(rng)), density,
+              rng, world);
+  }
+  for (double x = x0 + 9.5 * unit(rng); x < x1; x += 9.5)
+    SamplePole(Point(x, 6.8, 0), 0.15, 6, density, rng, world);
+  for (double x = x0 + 12.0 * unit(rng); x < x1; x += 12.0)
+    SamplePole(Point(x, -6.8, 0), 0.4, 3, density, rng, world);
+  return world;
+}
 
 Points MakeSyntheticStreet(uint64_t seed, double density) {
   std::mt19937_64 rng(seed);
@@ -90,17 +153,49 @@ Transform PoseFromYawTranslation(double yaw, const Eigen::Vector3d& translation)
   return T;
 }
 
-std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed) {
-  const Points world = MakeSyntheticStreet(seed);
-  std::vector<SyntheticScan> scans;
-  for (int i = 0; i < num_scans; ++i) {
-    SyntheticScan scan;
-    scan.T_world_scan =
-        PoseFromYawTranslation(0.04 * i, {-7.0 + 2.0 * i, 0.4 * std::sin(0.7 * i), 1.8});
-    scan.points =
-        SimulateScan(world, scan.T_world_scan, 35.0, 0.02, seed + 100 + static_cast<uint64_t>(i));
-    scans.push_back(std::move(scan));
+SyntheticDrive::SyntheticDrive(int num_scans, uint64_t seed, bool loop)
+    : num_scans_(std::max(num_scans, 0)), seed_(seed), loop_(loop) {
+  segments_.push_back(MakeSyntheticStreet(seed));
+  double farthest = kFirstScanX;
+  for (int i = 0; i < num_scans_; ++i) farthest = std::max(farthest, Pose(i)(0, 3));
+  const int last_segment =
+      static_cast<int>(std::ceil((farthest + kScanRange - kStreetEnd) / kSegmentLength));
+  for (int k = 1; k <= last_segment; ++k) segments_.push_back(MakeStreetSegment(seed, k));
+}
+
+Transform SyntheticDrive::Pose(int index) const {
+  // A loop's outbound leg is its first half, rounded up; the way back runs
+  // the same stations in reverse order in the other lane.
+  const int outbound = loop_ ? (num_scans_ + 1) / 2 : num_scans_;
+  const bool returning = index >= outbound;
+  const int station = returning ? 2 * outbound - 1 - index : index;
+  const double lane = returning ? kReturnLane : 0.0;
+  return PoseFromYawTranslation(0.04 * index, {kFirstScanX + kScanSpacing * station,
+                                               lane + 0.4 * std::sin(0.7 * index), 1.8});
+}
+
+SyntheticScan SyntheticDrive::Scan(int index) const {
+  if (index < 0 || index >= num_scans_) throw std::out_of_range("SyntheticDrive::Scan: index");
+  SyntheticScan scan;
+  scan.T_world_scan = Pose(index);
+  const uint64_t scan_seed = seed_ + 100 + static_cast<uint64_t>(index);
+  scan.points = SimulateScan(segments_[0], scan.T_world_scan, kScanRange, kScanNoise, scan_seed);
+  const double x = scan.T_world_scan(0, 3);
+  for (size_t k = 1; k < segments_.size(); ++k) {
+    const double x0 = SegmentStart(static_cast<int>(k));
+    if (x + kScanRange < x0 || x - kScanRange > x0 + kSegmentLength) continue;
+    const Points seen = SimulateScan(segments_[k], scan.T_world_scan, kScanRange, kScanNoise,
+                                     MixSeed(scan_seed, k));
+    scan.points.insert(scan.points.end(), seen.begin(), seen.end());
   }
+  return scan;
+}
+
+std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed, bool loop) {
+  const SyntheticDrive drive(num_scans, seed, loop);
+  std::vector<SyntheticScan> scans;
+  scans.reserve(static_cast<size_t>(drive.size()));
+  for (int i = 0; i < drive.size(); ++i) scans.push_back(drive.Scan(i));
   return scans;
 }
 

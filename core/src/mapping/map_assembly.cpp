@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <future>
 
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/registration/voxel_cloud.hpp"
@@ -28,6 +29,24 @@ Points WithinRange(const Points& points, const Point& origin, double max_range) 
     if ((p - origin).squaredNorm() <= max_sq) kept.push_back(p);
   }
   return kept;
+}
+
+// One scan ready to fuse: its ray-cast cells and, when the merged cloud is
+// wanted, its points within range (scan frame).
+struct PreparedScan {
+  ScanUpdate update;
+  Points cloud_points;
+};
+
+PreparedScan PrepareScan(const OccupancyMap& map, const ScanSource& scan, const Transform& pose,
+                         const MapBuildSettings& settings, bool want_cloud) {
+  PreparedScan prepared;
+  Points points = LoadPointCloud(scan.path, scan.load).points;
+  prepared.update = map.ComputeUpdate(points, pose, scan.sensor_origin, settings.fusion_threads);
+  if (want_cloud) {
+    prepared.cloud_points = WithinRange(points, scan.sensor_origin, settings.occupancy.max_range);
+  }
+  return prepared;
 }
 
 void WriteText(const std::string& path, const std::function<void(std::ostream&)>& write) {
@@ -89,15 +108,21 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   const bool want_cloud = !outputs.cloud_ply.empty();
   const int total = static_cast<int>(scans.size());
 
+  const auto prepare = [&](int i) {
+    const auto index = static_cast<size_t>(i);
+    return PrepareScan(map, scans[index], poses[index], settings, want_cloud);
+  };
+  // A two-stage pipeline: scan i+1 is loaded and ray cast on a helper thread
+  // while this thread applies scan i to the tree, in scan order. Whether the
+  // helper exists changes only timing, never the tree.
+  const bool pipelined = settings.fusion_threads > 1;
+  std::future<PreparedScan> next;
   for (int i = 0; i < total; ++i) {
     ThrowIfStopped(callbacks);
-    const ScanSource& scan = scans[static_cast<size_t>(i)];
-    const Points points = LoadPointCloud(scan.path, scan.load).points;
-    map.InsertScan(points, poses[static_cast<size_t>(i)], scan.sensor_origin);
-    if (want_cloud) {
-      cloud.Add(WithinRange(points, scan.sensor_origin, settings.occupancy.max_range),
-                poses[static_cast<size_t>(i)]);
-    }
+    PreparedScan current = next.valid() ? next.get() : prepare(i);
+    if (pipelined && i + 1 < total) next = std::async(std::launch::async, prepare, i + 1);
+    map.ApplyUpdate(current.update);
+    if (want_cloud) cloud.Add(current.cloud_points, poses[static_cast<size_t>(i)]);
     Report(callbacks, "fusing", i + 1, total);
   }
 

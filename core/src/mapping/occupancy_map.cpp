@@ -1,18 +1,238 @@
 #include "boicp/mapping/occupancy_map.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <unordered_map>
+#include <vector>
 
 #include <octomap/OcTree.h>
 
+#include "boicp/util/parallel_for.hpp"
+
 namespace boicp {
 namespace {
+
+using octomap::KeySet;
+using octomap::OcTreeKey;
+using octomap::point3d;
 
 void Require(bool ok, const std::string& message) {
   if (!ok) throw InputError("map settings: " + message);
 }
 
+// An OcTree whose updates skip OctoMap's early-abort search. updateNode
+// first searches the key and returns if its leaf is already clamped in the
+// update's direction; otherwise it descends again to update. The second
+// descent alone gives the same tree: a clamped leaf updated the same way is
+// clamped back to the same value, and its path already exists. That saves
+// one of the two descents per cell, about half of the tree update.
+class FusionOcTree : public octomap::OcTree {
+ public:
+  using octomap::OcTree::OcTree;
+
+  void Update(const OcTreeKey& key, bool occupied) {
+    const float log_odds = occupied ? prob_hit_log : prob_miss_log;
+    bool created_root = false;
+    if (root == nullptr) {
+      root = new octomap::OcTreeNode();
+      ++tree_size;
+      created_root = true;
+    }
+    updateNodeRecurs(root, created_root, key, 0, log_odds, /*lazy_eval=*/true);
+  }
+};
+
+// A set of cells as bitmaps of 16 x 16 x 16-cell blocks. A ray marks
+// millions of cells, mostly repeats near the sensor; setting a bit in the
+// block the ray is already in costs far less than a hash-set insertion, and
+// memory stays in proportion to the blocks touched.
+class CellSet {
+ public:
+  using BlockId = uint64_t;
+  using Block = std::array<uint64_t, 64>;  // 4096 bits
+
+  static BlockId BlockOf(const OcTreeKey& key) {
+    return (static_cast<BlockId>(key[0] >> 4) << 24) | (static_cast<BlockId>(key[1] >> 4) << 12) |
+           static_cast<BlockId>(key[2] >> 4);
+  }
+
+  void Insert(const OcTreeKey& key) {
+    const BlockId id = BlockOf(key);
+    if (id != last_id_ || last_ == nullptr) {
+      last_ = &blocks_[id];  // value-initialised: all bits clear
+      last_id_ = id;
+    }
+    const unsigned bit = BitOf(key);
+    (*last_)[bit >> 6] |= uint64_t{1} << (bit & 63);
+  }
+
+  void Erase(const OcTreeKey& key) {
+    const auto it = blocks_.find(BlockOf(key));
+    if (it == blocks_.end()) return;
+    const unsigned bit = BitOf(key);
+    it->second[bit >> 6] &= ~(uint64_t{1} << (bit & 63));
+  }
+
+  void UniteWith(const CellSet& other) {
+    for (const auto& [id, block] : other.blocks_) {
+      Block& mine = blocks_[id];
+      for (size_t w = 0; w < mine.size(); ++w) mine[w] |= block[w];
+    }
+    last_ = nullptr;
+  }
+
+  size_t Count() const {
+    size_t count = 0;
+    for (const auto& entry : blocks_) {
+      for (const uint64_t word : entry.second)
+        count += static_cast<size_t>(__builtin_popcountll(word));
+    }
+    return count;
+  }
+
+  template <typename Visit>
+  void ForEach(Visit visit) const {
+    for (const auto& [id, block] : blocks_) {
+      for (size_t w = 0; w < block.size(); ++w) {
+        for (uint64_t word = block[w]; word != 0; word &= word - 1) {
+          const unsigned bit =
+              static_cast<unsigned>(w * 64) + static_cast<unsigned>(__builtin_ctzll(word));
+          visit(KeyOf(id, bit));
+        }
+      }
+    }
+  }
+
+ private:
+  static unsigned BitOf(const OcTreeKey& key) {
+    return (static_cast<unsigned>(key[0] & 15) << 8) | (static_cast<unsigned>(key[1] & 15) << 4) |
+           static_cast<unsigned>(key[2] & 15);
+  }
+  static OcTreeKey KeyOf(BlockId id, unsigned bit) {
+    const auto coordinate = [&](int shift_id, int shift_bit) {
+      return static_cast<octomap::key_type>((((id >> shift_id) & 0xFFF) << 4) |
+                                            ((bit >> shift_bit) & 15));
+    };
+    return OcTreeKey(coordinate(24, 8), coordinate(12, 4), coordinate(0, 0));
+  }
+
+  std::unordered_map<BlockId, Block> blocks_;
+  BlockId last_id_ = 0;
+  Block* last_ = nullptr;  // the block of the last insertion (element pointers are stable)
+};
+
+// Which of `shards` sets a block's cells belong to, so that each shard is
+// merged on its own thread. The block id is mixed first: neighbouring
+// blocks should land in different shards.
+size_t ShardOf(CellSet::BlockId block, size_t shards) {
+  return static_cast<size_t>((block * 0x9E3779B97F4A7C15ull) >> 40) % shards;
+}
+
+// Free and occupied cells, each split into shards by the cell's block.
+struct ShardedCells {
+  explicit ShardedCells(size_t shards) : free(shards), occupied(shards) {}
+  std::vector<CellSet> free;
+  std::vector<KeySet> occupied;
+};
+
+// The scan in the map frame, in OctoMap's single precision.
+octomap::Pointcloud ToMapFrame(const Points& points, const Transform& T_map_scan) {
+  const Eigen::Matrix3d R = T_map_scan.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T_map_scan.topRightCorner<3, 1>();
+  octomap::Pointcloud cloud;
+  cloud.reserve(points.size());
+  for (const Point& p : points) {
+    const Point q = R * p + t;
+    cloud.push_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                    static_cast<float>(q.z()));
+  }
+  return cloud;
+}
+
+// One endpoint per leaf, at the leaf's centre: OctoMap's discretised
+// insertion (computeDiscreteUpdate), which casts one ray per leaf hit.
+std::vector<point3d> DiscretisedEndpoints(const octomap::OcTree& tree,
+                                          const octomap::Pointcloud& cloud) {
+  KeySet leaves;
+  std::vector<point3d> endpoints;
+  endpoints.reserve(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const OcTreeKey key = tree.coordToKey(cloud[i]);
+    if (leaves.insert(key).second) endpoints.push_back(tree.keyToCoord(key));
+  }
+  return endpoints;
+}
+
+// Casts the rays to endpoints [begin, end) as OctoMap's computeUpdate does
+// without a bounding box: cells along a ray are free, its endpoint occupied;
+// a ray longer than max_range (when >= 0) is cut there and marks no endpoint.
+void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints, size_t begin,
+              size_t end, const point3d& origin, double max_range, ShardedCells& cells) {
+  const size_t shards = cells.free.size();
+  octomap::KeyRay ray;
+  const auto mark_free = [&] {
+    for (const OcTreeKey& key : ray) {
+      cells.free[shards == 1 ? 0 : ShardOf(CellSet::BlockOf(key), shards)].Insert(key);
+    }
+  };
+  for (size_t i = begin; i < end; ++i) {
+    const point3d& p = endpoints[i];
+    if (max_range < 0.0 || (p - origin).norm() <= max_range) {
+      if (tree.computeRayKeys(origin, p, ray)) mark_free();
+      OcTreeKey key;
+      if (tree.coordToKeyChecked(p, key)) {
+        cells.occupied[ShardOf(CellSet::BlockOf(key), shards)].insert(key);
+      }
+    } else {
+      const point3d direction = (p - origin).normalized();
+      const point3d cut_end = origin + direction * static_cast<float>(max_range);
+      if (tree.computeRayKeys(origin, cut_end, ray)) mark_free();
+    }
+  }
+}
+
+// Unites shard `shard` of every chunk's cells into `merged`, then drops from
+// the free cells those also occupied (OctoMap prefers occupied).
+void MergeShard(std::vector<ShardedCells>& chunks, size_t shard, ShardedCells& merged) {
+  CellSet& free = merged.free[shard];
+  KeySet& occupied = merged.occupied[shard];
+  free = std::move(chunks[0].free[shard]);
+  occupied = std::move(chunks[0].occupied[shard]);
+  for (size_t c = 1; c < chunks.size(); ++c) {
+    free.UniteWith(chunks[c].free[shard]);
+    occupied.insert(chunks[c].occupied[shard].begin(), chunks[c].occupied[shard].end());
+    chunks[c].free[shard] = CellSet();
+    KeySet().swap(chunks[c].occupied[shard]);
+  }
+  for (const OcTreeKey& key : occupied) free.Erase(key);
+}
+
 }  // namespace
+
+struct ScanUpdate::Impl {
+  explicit Impl(size_t shards) : cells(shards) {}
+  ShardedCells cells;  // free and occupied are disjoint
+};
+
+ScanUpdate::ScanUpdate() : impl_(std::make_unique<Impl>(1)) {}
+ScanUpdate::~ScanUpdate() = default;
+ScanUpdate::ScanUpdate(ScanUpdate&&) noexcept = default;
+ScanUpdate& ScanUpdate::operator=(ScanUpdate&&) noexcept = default;
+
+size_t ScanUpdate::FreeCells() const {
+  size_t count = 0;
+  for (const CellSet& shard : impl_->cells.free) count += shard.Count();
+  return count;
+}
+
+size_t ScanUpdate::OccupiedCells() const {
+  size_t count = 0;
+  for (const KeySet& shard : impl_->cells.occupied) count += shard.size();
+  return count;
+}
 
 struct OccupancyMap::Impl {
   explicit Impl(const OccupancySettings& s) : settings(s), tree(s.resolution) {
@@ -22,7 +242,7 @@ struct OccupancyMap::Impl {
     tree.setClampingThresMax(s.clamp_max);
   }
   OccupancySettings settings;
-  octomap::OcTree tree;
+  FusionOcTree tree;
   bool inner_dirty = false;  // lazy insertion leaves inner nodes stale until updated
 
   void UpdateInner() {
@@ -52,22 +272,43 @@ OccupancyMap::~OccupancyMap() = default;
 
 void OccupancyMap::InsertScan(const Points& points, const Transform& T_map_scan,
                               const Point& sensor_origin) {
-  const Eigen::Matrix3d R = T_map_scan.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t = T_map_scan.topRightCorner<3, 1>();
-  octomap::Pointcloud cloud;
-  cloud.reserve(points.size());
-  for (const Point& p : points) {
-    const Point q = R * p + t;
-    cloud.push_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                    static_cast<float>(q.z()));
-  }
-  const Point origin = R * sensor_origin + t;
+  ApplyUpdate(ComputeUpdate(points, T_map_scan, sensor_origin, 1));
+}
+
+ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_map_scan,
+                                       const Point& sensor_origin, int threads) const {
+  const octomap::OcTree& tree = impl_->tree;
+  const std::vector<point3d> endpoints = DiscretisedEndpoints(tree, ToMapFrame(points, T_map_scan));
+  const Point origin_d =
+      T_map_scan.topLeftCorner<3, 3>() * sensor_origin + T_map_scan.topRightCorner<3, 1>();
+  const point3d origin(static_cast<float>(origin_d.x()), static_cast<float>(origin_d.y()),
+                       static_cast<float>(origin_d.z()));
   const double max_range = impl_->settings.max_range > 0.0 ? impl_->settings.max_range : -1.0;
-  impl_->tree.insertPointCloud(
-      cloud,
-      octomap::point3d(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
-                       static_cast<float>(origin.z())),
-      max_range, /*lazy_eval=*/true, /*discretize=*/true);
+
+  const size_t workers = static_cast<size_t>(std::max(threads, 1));
+  const size_t chunk_count = std::max<size_t>(1, std::min(workers, endpoints.size()));
+  const size_t shards = workers;
+  std::vector<ShardedCells> chunks(chunk_count, ShardedCells(shards));
+  ParallelFor(chunk_count, threads, [&](size_t c) {
+    const size_t begin = endpoints.size() * c / chunk_count;
+    const size_t end = endpoints.size() * (c + 1) / chunk_count;
+    CastRays(tree, endpoints, begin, end, origin, max_range, chunks[c]);
+  });
+
+  ScanUpdate update;
+  update.impl_ = std::make_unique<ScanUpdate::Impl>(shards);
+  ParallelFor(shards, threads, [&](size_t s) { MergeShard(chunks, s, update.impl_->cells); });
+  return update;
+}
+
+void OccupancyMap::ApplyUpdate(const ScanUpdate& update) {
+  FusionOcTree& tree = impl_->tree;
+  for (const CellSet& shard : update.impl_->cells.free) {
+    shard.ForEach([&](const OcTreeKey& key) { tree.Update(key, /*occupied=*/false); });
+  }
+  for (const KeySet& shard : update.impl_->cells.occupied) {
+    for (const OcTreeKey& key : shard) tree.Update(key, /*occupied=*/true);
+  }
   impl_->inner_dirty = true;
 }
 

@@ -30,9 +30,41 @@ struct SyntheticScan {
   Transform T_world_scan = Transform::Identity();
 };
 
-/// `num_scans` scans of the street, 2 m apart with a gentle weave and turn,
-/// seen by a 35 m-range sensor 1.8 m above the ground with 2 cm noise.
-/// Reproducible for a given seed.
-std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed);
+/// Surface samples (world frame) of the street's continuation number
+/// `segment` >= 1: the 80 m beyond MakeSyntheticStreet's end (x = 40 m) for
+/// segment 1, the 80 m beyond that for segment 2, and so on. Facades, cars,
+/// poles and trees are placed at random from (seed, segment), so every
+/// segment differs and is reproducible.
+Points MakeStreetSegment(uint64_t seed, int segment, double density = 40.0);
+
+/// A generated drive along the street, which extends (MakeStreetSegment) as
+/// far as the drive goes: scans 2 m apart with a gentle weave and a sensor
+/// that turns 0.04 rad per scan, seen by a 35 m-range sensor 1.8 m above the
+/// ground with 2 cm noise. With `loop`, the second half of the drive comes
+/// back in the other lane and ends beside the start. Scans are generated one
+/// at a time, so a long drive needs memory for its street only.
+class SyntheticDrive {
+ public:
+  /// Precondition: num_scans >= 0. Builds the street the drive sees.
+  SyntheticDrive(int num_scans, uint64_t seed, bool loop = false);
+
+  int size() const { return num_scans_; }
+
+  /// True T_world_scan of scan `index` in [0, size()).
+  Transform Pose(int index) const;
+
+  /// Scan `index` in [0, size()): the same points for the same seed, and for
+  /// a scan of the outbound leg whatever the drive's length.
+  SyntheticScan Scan(int index) const;
+
+ private:
+  int num_scans_;
+  uint64_t seed_;
+  bool loop_;
+  std::vector<Points> segments_;  // [0] = MakeSyntheticStreet, then MakeStreetSegment(k)
+};
+
+/// Every scan of SyntheticDrive(num_scans, seed, loop), in memory at once.
+std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed, bool loop = false);
 
 }  // namespace boicp

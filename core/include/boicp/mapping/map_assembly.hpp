@@ -52,6 +52,10 @@ PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
 struct MapBuildSettings {
   OccupancySettings occupancy;
   double cloud_voxel = 0.0;  // metres, merged-cloud voxel; 0 = occupancy.resolution
+  /// Threads FuseScans ray casts each scan on (< 1 counts as 1). With more
+  /// than one, the tree update of one scan also overlaps the ray casting of
+  /// the next. The outputs are the same bytes whatever the count.
+  int fusion_threads = 1;
 };
 
 /// Where to write each output; an empty path skips that output. Every file
@@ -80,7 +84,10 @@ struct FusionSummary {
 
 /// Loads every scan, inserts it into the OctoMap at its pose with its sensor
 /// origin, accumulates the merged cloud (points within max_range only), and
-/// writes the requested outputs. Throws InputError for invalid settings or a
+/// writes the requested outputs. Scans stream through: at most two are held
+/// at once (one ray cast while the one before updates the tree), so memory
+/// beyond the tree and the voxel-downsampled cloud does not grow with the
+/// number of scans. Throws InputError for invalid settings or a
 /// scan that no longer loads, Cancelled when stop_requested fires, and
 /// std::runtime_error when an output cannot be written.
 FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,

@@ -26,6 +26,24 @@ struct OccupancySettings {
 /// Throws InputError naming the first invalid field.
 void ValidateOccupancySettings(const OccupancySettings& settings);
 
+/// The cells one scan marks free and occupied, ray cast but not yet applied
+/// to a map. Holds memory in proportion to the cells the scan touches.
+class ScanUpdate {
+ public:
+  ScanUpdate();
+  ~ScanUpdate();
+  ScanUpdate(ScanUpdate&&) noexcept;
+  ScanUpdate& operator=(ScanUpdate&&) noexcept;
+
+  size_t FreeCells() const;
+  size_t OccupiedCells() const;
+
+ private:
+  friend class OccupancyMap;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 class OccupancyMap {
  public:
   /// Throws InputError for invalid settings.
@@ -38,7 +56,22 @@ class OccupancyMap {
   /// `sensor_origin` the ray origin in the scan frame. Endpoints are reduced
   /// to one per leaf before ray casting (OctoMap's discretised insertion),
   /// which keeps dense scans cheap without changing the result much.
+  /// Equivalent to ApplyUpdate(ComputeUpdate(points, T_map_scan, sensor_origin, 1)).
   void InsertScan(const Points& points, const Transform& T_map_scan, const Point& sensor_origin);
+
+  /// Ray casts one scan (arguments as for InsertScan) on `threads` threads,
+  /// the calling one among them (< 1 counts as 1), without changing the map:
+  /// it reads only the map's settings, so it may run while another thread
+  /// applies an earlier update. The cells are the ones OctoMap's discretised
+  /// insertPointCloud updates, whatever the thread count.
+  ScanUpdate ComputeUpdate(const Points& points, const Transform& T_map_scan,
+                           const Point& sensor_origin, int threads) const;
+
+  /// Applies an update computed by this map's ComputeUpdate: a miss for every
+  /// free cell, then a hit for every occupied one. Each cell is in at most one
+  /// of the two sets, so the tree does not depend on the order within a set
+  /// and is bit-identical to OctoMap's own insertion of the same scan.
+  void ApplyUpdate(const ScanUpdate& update);
 
   /// Number of leaves currently believed occupied (after inner nodes are updated).
   size_t OccupiedLeaves();
