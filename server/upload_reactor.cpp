@@ -61,7 +61,7 @@ UploadReactor::UploadReactor(const ServiceDeps& deps, v1::UploadScanResponse* re
                              const grpc::Status& auth)
     : deps_(deps), response_(response) {
   if (!auth.ok()) {
-    Finish(auth);
+    FinishUpload(auth);
     return;
   }
   StartRead(&request_);
@@ -77,12 +77,17 @@ void UploadReactor::OnReadDone(bool ok) {
     return grpc::Status::OK;
   });
   if (!status.ok()) {
-    Finish(status);
+    FinishUpload(status);
   } else if (ok) {
     StartRead(&request_);
   } else {
-    Finish(grpc::Status::OK);
+    FinishUpload(grpc::Status::OK);
   }
+}
+
+void UploadReactor::FinishUpload(const grpc::Status& status) {
+  ticket_.reset();
+  Finish(status);
 }
 
 void UploadReactor::OnDone() {

@@ -34,6 +34,9 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   void AcceptMetadata(const ::boicp::v1::ScanMetadata& metadata);
   void AcceptChunk(const std::string& bytes);
   void Complete();
+  /// Frees the upload's slot and bytes in the budget, then finishes: a client
+  /// that has heard this upload end is never refused because of it.
+  void FinishUpload(const grpc::Status& status);
   /// Verifies the stored copy a client wants to reuse; false (and the reason
   /// in corruption_) when it failed its hash check.
   bool StoredCopyIntact(const std::string& scan_id);

@@ -114,7 +114,7 @@ if [ -n "$prebuilt" ]; then
   build_flags+=(--build-arg BINARIES=prebuilt)
 fi
 start=$(date +%s)
-log "building $image${prebuilt:+ from $bin's binaries} (log $tmp/build.log)"
+log "building $image${prebuilt:+ around the binaries of $bin} (log $tmp/build.log)"
 if ! "$engine" build "${build_flags[@]}" "$context" >"$tmp/build.log" 2>&1; then
   tail -n 40 "$tmp/build.log" >&2
   fail "$engine build"
