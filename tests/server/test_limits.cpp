@@ -2,6 +2,10 @@
 // limit's value and its flag in the message, while a request at the limit
 // still passes.
 
+#include <chrono>
+#include <memory>
+#include <thread>
+
 #include <gmock/gmock.h>
 
 #include "../support/demo_sequence.hpp"
@@ -181,25 +185,33 @@ TEST_F(Limits, UploadsInFlight) {
   StartDaemon(
       {"--workers", "1", "--max-concurrent-uploads", "1", "--max-upload-bytes-in-flight", "1000"});
   auto client = Client();
-  grpc::ClientContext context;
-  v1::UploadScanResponse response;
-  auto open_upload = client.stub().UploadScan(&context, &response);
   v1::UploadScanRequest message;
   *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, XyzScan(3).size());
-  ASSERT_TRUE(open_upload->Write(message));
-  // Until the server has read that metadata a second upload may still pass
-  // (and then the first may be the one refused): retry until one is refused.
+  // An upload holds the one slot once the server has read its metadata. Until
+  // then a second upload may take the slot first, and the open one is the
+  // upload refused; so open one, give the server a moment, probe, and start
+  // over (ending the open one) until the probe is the upload refused.
+  v1::UploadScanResponse response;
+  std::unique_ptr<grpc::ClientContext> context;
+  std::unique_ptr<grpc::ClientWriter<v1::UploadScanRequest>> open_upload;
   grpc::Status status;
-  for (int attempt = 0; attempt < 200; ++attempt) {
+  for (int attempt = 0; attempt < 50 && status.ok(); ++attempt) {
+    if (open_upload) {
+      open_upload->WritesDone();
+      open_upload->Finish();
+    }
+    context = std::make_unique<grpc::ClientContext>();
+    open_upload = client.stub().UploadScan(context.get(), &response);
+    ASSERT_TRUE(open_upload->Write(message));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
     status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)});
-    if (!status.ok()) break;
   }
   EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("(--max-concurrent-uploads 1)"));
   message.set_chunk(XyzScan(3));
-  open_upload->Write(message);
+  ASSERT_TRUE(open_upload->Write(message));
   open_upload->WritesDone();
-  open_upload->Finish();
+  EXPECT_TRUE(open_upload->Finish().ok()) << "the upload holding the slot completes";
 
   const std::string big = XyzScan(200);  // over 1000 bytes
   status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, big.size()), {big});
