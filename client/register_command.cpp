@@ -11,6 +11,7 @@
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/settings/settings_flags.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "json_output.hpp"
@@ -31,6 +32,8 @@ struct RegisterFlags {
 BoIcpConfig BuildConfig(const RegisterFlags& f) {
   settings::RequestedSettings given = f.settings;
   settings::ApplyFlagTexts(f.setting_texts, settings::kRegister, given);
+  // One registration alone on the machine: every core, unless told otherwise.
+  if (!given.threads) given.threads = AvailableCores();
   return settings::ConfigFromSettings(given);
 }
 

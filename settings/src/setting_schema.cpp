@@ -81,7 +81,8 @@ std::vector<SettingField> BuildSchema() {
        kRegister, "Points each evaluation's ICP starts on before it finishes on all (0 = all)",
        kNotInApi, OptionalBinding<uint64_t>{&RS::coarse_icp_points, &C::coarse_icp_points}},
       {"threads", "--threads", nullptr, "threads", kNone, "", kRegister,
-       "Threads for the search and the refinement (the answer does not depend on it)",
+       "Threads for the search and the refinement (default: every core; the answer does not "
+       "depend on it)",
        "Map and the daemon run one registration thread per pair and spread pairs over threads "
        "(map --threads, boicpd --registration-threads).",
        OptionalBinding<int>{&RS::threads, &C::threads}},
