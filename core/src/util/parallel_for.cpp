@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <thread>
 #include <vector>
 
 namespace boicp {
@@ -18,6 +19,25 @@ void InArena(int threads, const Loop& loop) {
   tbb::task_arena arena(threads);
   arena.execute(loop);
 }
+
+// The ThreadSanitizer build cannot see oneTBB's synchronisation (Debian's
+// libtbb is not instrumented), so there the same tasks run on plain threads,
+// each taking an equal block of indices, and TSan checks the task bodies.
+void OnPlainThreads(size_t count, int threads, const std::function<void(size_t, size_t)>& body) {
+  const size_t workers = std::min<size_t>(count, static_cast<size_t>(threads));
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers; ++w) {
+    pool.emplace_back([&, w] { body(count * w / workers, count * (w + 1) / workers); });
+  }
+  body(0, count / workers);
+  for (std::thread& thread : pool) thread.join();
+}
+
+#ifdef BOICP_PLAIN_THREADS
+constexpr bool kPlainThreads = true;
+#else
+constexpr bool kPlainThreads = false;
+#endif
 
 }  // namespace
 
@@ -35,6 +55,10 @@ void ParallelFor(size_t count, int threads, const std::function<void(size_t)>& t
   };
   if (threads <= 1 || count == 1) {
     for (size_t i = 0; i < count; ++i) run(i);
+  } else if (kPlainThreads) {
+    OnPlainThreads(count, threads, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) run(i);
+    });
   } else {
     // One index a task: each takes milliseconds, so balance beats batching.
     InArena(threads, [&] {
@@ -56,6 +80,10 @@ void ParallelForRanges(size_t count, int threads,
   if (count == 0) return;
   if (threads <= 1) {
     body(0, count);
+    return;
+  }
+  if (kPlainThreads) {
+    OnPlainThreads(count, threads, body);
     return;
   }
   // One contiguous block a thread: the work per index is even, and a static
