@@ -1,7 +1,7 @@
 # boicp image: boicpd (the gRPC map-building daemon) and boicp (the client).
-#   docker build -t boicp .
+#   docker build -t boicp:0.1.0 .
 #   docker run -d --name boicpd -e BOICPD_WORKERS=2 -p 127.0.0.1:50051:50051 \
-#     -v boicpd-data:/var/lib/boicpd boicp
+#     -v boicpd-data:/var/lib/boicpd boicp:0.1.0
 # The build stage uses the same dependency script and configure flags as
 # .ci/run but builds only the two binaries: .ci/run runs the tests on its host
 # build, then runs this image with tests/deploy/test_image.sh. (podman keeps the
