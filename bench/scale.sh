@@ -52,6 +52,8 @@ for tool in boicp boicpd; do
 done
 
 WORK="$(mktemp -d /tmp/boicp-scale.XXXXXX)"
+# shellcheck source=bench/start_boicpd.sh
+source "$(dirname "$0")/start_boicpd.sh"
 PID=""
 trap '[ -n "$PID" ] && kill -TERM "$PID" 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"' EXIT
 mkdir -p "$OUT"
@@ -105,21 +107,11 @@ print(f'map,$n,$((n - 1)),{e:.1f},0,{r:.1f},{f - r:.1f},{e - f:.1f},$rss,' +
 }
 
 daemon_run() {
-  local n=$1 drive data log addr job watch_log
+  local n=$1 drive data log job watch_log
   drive="$(generate "$n")"
   data="$WORK/boicpd_$n"
   log="$OUT/boicpd_$n.log"
-  "$BIN/boicpd" --listen 127.0.0.1:0 --data-dir "$data" --workers "$THREADS" \
-    --registration-threads 1 >"$log" 2>&1 &
-  PID=$!
-  addr=""
-  for _ in $(seq 1 300); do
-    addr="$(grep -o 'listening on [^ ]*' "$log" | head -n 1 | cut -d' ' -f3 || true)"
-    [ -n "$addr" ] && break
-    sleep 0.1
-  done
-  [ -n "$addr" ] || { echo "boicpd did not start:" >&2; cat "$log" >&2; exit 1; }
-  export BOICP_SERVER="$addr"
+  start_boicpd "$log" --data-dir "$data" --workers "$THREADS" --registration-threads 1
   watch_log="$OUT/watch_$n.log"
   # The upload (submit) is part of what a user waits for: its own column.
   local start_ns=$(date +%s%N)

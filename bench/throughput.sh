@@ -39,6 +39,8 @@ fi
 
 CLK_TCK="$(getconf CLK_TCK)"
 WORK="$(mktemp -d /tmp/boicp-throughput.XXXXXX)"
+# shellcheck source=bench/start_boicpd.sh
+source "$(dirname "$0")/start_boicpd.sh"
 PID=""
 trap '[ -n "$PID" ] && kill -TERM "$PID" 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"' EXIT
 
@@ -72,17 +74,8 @@ mkdir -p "$(dirname "$OUT")"
 
 for workers in $WORKERS; do
   log="$WORK/boicpd_w$workers.log"
-  "$BIN/boicpd" --listen 127.0.0.1:0 --data-dir "$WORK/data_w$workers" --workers "$workers" \
-    --registration-threads 1 >"$log" 2>&1 &
-  PID=$!
-  addr=""
-  for _ in $(seq 1 300); do
-    addr="$(grep -o 'listening on [^ ]*' "$log" | head -n 1 | cut -d' ' -f3 || true)"
-    [ -n "$addr" ] && break
-    sleep 0.1
-  done
-  [ -n "$addr" ] || { echo "boicpd did not start:" >&2; cat "$log" >&2; exit 1; }
-  export BOICP_SERVER="$addr"
+  start_boicpd "$log" --data-dir "$WORK/data_w$workers" --workers "$workers" \
+    --registration-threads 1
 
   job="$("$BIN/boicp" submit "$DATA" --count $((PAIRS + 1)) --config C --label throughput)"
   # One long-lived client follows the job and prints a line at every stage
