@@ -7,6 +7,7 @@
 
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/mapping/map_preview.hpp"
+#include "boicp/mapping/map_up.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
@@ -83,6 +84,9 @@ int RunExport(const ExportFlags& f) {
     throw std::runtime_error("job " + f.job_id + " is " + rpc::JobStateName(job.state()) +
                              "; only a succeeded job can be exported");
   }
+  // Without --sensor-up, the job's scan format says where its sensors' up is.
+  if (!up_options.sensor_up && job.settings().scan_format() != v1::SCAN_FORMAT_UNSPECIFIED)
+    up_options.sensor_up = SensorUp(rpc::FormatFromProto(job.settings().scan_format()));
   const fs::path parent = fs::path(output).parent_path();
   if (!parent.empty()) fs::create_directories(parent);
   uint64_t bytes = 0;

@@ -99,6 +99,8 @@ class JobRun : public MapProgressSink {
         batch_spec_.scans, batch_spec_.config, batch_spec_.map.occupancy, batch_spec_.map_auto);
     *job_.mutable_settings() =
         ChosenSettingsToProto(batch_spec_.config, batch_spec_.map, auto_fields);
+    job_.mutable_settings()->set_scan_format(
+        rpc::ScanFormatOf(batch_spec_.scans.at(0).load.format));
     batch_.scans = batch_spec_.scans;
     batch_.config = batch_spec_.config;
     batch_.map = batch_spec_.map;

@@ -20,13 +20,6 @@ constexpr std::pair<CloudFormat, v1::ScanFormat> kScanFormats[] = {
     {CloudFormat::kDepthPng, v1::SCAN_FORMAT_DEPTH_PNG},
 };
 
-v1::ScanFormat ScanFormatOf(CloudFormat format) {
-  for (const auto& [cloud, proto] : kScanFormats) {
-    if (cloud == format) return proto;
-  }
-  return v1::SCAN_FORMAT_UNSPECIFIED;
-}
-
 }  // namespace
 
 Transform TransformFromProto(const v1::Transform& proto, const std::string& field) {
@@ -70,6 +63,13 @@ Point PointFromProto(const v1::Vector3& proto, const std::string& field) {
   const Point p(proto.x(), proto.y(), proto.z());
   if (!p.allFinite()) throw InputError(field + ": non-finite value");
   return p;
+}
+
+v1::ScanFormat ScanFormatOf(CloudFormat format) {
+  for (const auto& [cloud, proto] : kScanFormats) {
+    if (cloud == format) return proto;
+  }
+  return v1::SCAN_FORMAT_UNSPECIFIED;
 }
 
 CloudFormat FormatFromProto(int format) {

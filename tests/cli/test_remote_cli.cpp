@@ -118,8 +118,10 @@ class RemoteCli : public ::testing::Test {
     return Lines(r.out).empty() ? "" : Lines(r.out)[0];
   }
 
-  // Exports bt, ot, ply, tum and kitti and checks each file and both previews.
-  void ExportAndCheck(const std::string& job, size_t num_scans) {
+  // Exports bt, ot, ply, tum and kitti and checks each file and both
+  // previews, and that the previews' up came from `up_prior` (the job's scan
+  // format tells it).
+  void ExportAndCheck(const std::string& job, size_t num_scans, const std::string& up_prior) {
     const fs::path out = dir_ / "export";
     for (const char* format : {"bt", "ot", "ply", "tum", "kitti"}) {
       const fs::path file = out / (std::string("map_") + format + "." + format);
@@ -127,6 +129,9 @@ class RemoteCli : public ::testing::Test {
           Run("export " + job + " --format " + format + " -o " + file.string() + server_);
       ASSERT_EQ(r.exit_code, 0) << format << ": " << r.err;
       EXPECT_TRUE(r.out.empty()) << r.out;
+      if (std::string(format) == "bt") {
+        EXPECT_THAT(r.err, HasSubstr(up_prior));
+      }
       ASSERT_TRUE(fs::exists(file)) << file;
       EXPECT_FALSE(HasStagingFile(out));
     }
@@ -223,7 +228,7 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_THAT(again.err, HasSubstr("4 already on the daemon"));
   EXPECT_EQ(Lines(again.out).size(), 1u);
 
-  ExportAndCheck(job, 4);
+  ExportAndCheck(job, 4, "the sensors' up");
   // Without --format, the extension of -o names it.
   const RunResult by_name = Run("export " + job + " -o " + (dir_ / "t.tum").string() + server_);
   ASSERT_EQ(by_name.exit_code, 0) << by_name.err;
@@ -391,7 +396,7 @@ TEST_F(RemoteCli, KittiSubmitWaitAndExport) {
   if (!fs::exists(kitti / "velodyne")) GTEST_SKIP() << "no KITTI data in " << kitti;
   StartDaemon();
   const std::string job = SubmitAndWait(kitti.string() + " --config A --count 4");
-  ExportAndCheck(job, 4);
+  ExportAndCheck(job, 4, "the sensors' up");
 }
 
 TEST_F(RemoteCli, SevenScenesSubmitWaitAndExport) {
@@ -402,7 +407,7 @@ TEST_F(RemoteCli, SevenScenesSubmitWaitAndExport) {
   const std::string job = SubmitAndWait(scenes.string() +
                                         " --config A --stride 30 --count 4 --voxel 0.05 "
                                         "--translation-bounds 0.5,0.5,0.5 --resolution 0.05");
-  ExportAndCheck(job, 4);
+  ExportAndCheck(job, 4, "the sensors' up");
 }
 
 }  // namespace

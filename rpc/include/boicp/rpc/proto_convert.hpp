@@ -25,6 +25,8 @@ v1::Vector3 PointToProto(const Point& point);
 
 /// Throws InputError for SCAN_FORMAT_UNSPECIFIED or a value this daemon does not know.
 CloudFormat FormatFromProto(int format);
+/// SCAN_FORMAT_UNSPECIFIED for kAuto.
+v1::ScanFormat ScanFormatOf(CloudFormat format);
 
 /// Format and depth options to load a stored scan with. Throws InputError
 /// when a depth image lacks intrinsics or scale.
