@@ -19,7 +19,7 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 // An XYZ scan whose fusion at 1 cm leaves takes seconds yet builds a small
-// tree: points every 20 cm out to 100 m on 100 rays from the sensor. Each
+// tree: points every 30 cm out to 100 m on 100 rays from the sensor. Each
 // point casts a ray of up to 10,000 cells, and all of them share the cells
 // of 100 lines. `seed` turns the star, so that two scans differ.
 std::string StarScan(int seed) {
@@ -31,7 +31,7 @@ std::string StarScan(int seed) {
     const double z = 1.0 - 2.0 * (r + 0.5) / kRays;
     const double radius = std::sqrt(1.0 - z * z);
     const double angle = golden * r + 0.01 * seed;
-    for (double d = 1.0; d <= 100.0; d += 0.2) {
+    for (double d = 1.0; d <= 100.0; d += 0.3) {
       std::snprintf(line, sizeof line, "%.3f %.3f %.3f\n", d * radius * std::cos(angle),
                     d * radius * std::sin(angle), d * z);
       text += line;
@@ -42,8 +42,9 @@ std::string StarScan(int seed) {
 
 class LongFusion : public ServerTest {
  protected:
-  // Submits two star scans at 1 cm leaves and waits until fusion has run for
-  // a second, well inside the first scan.
+  // Submits two star scans at 1 cm leaves and waits until fusion has begun
+  // its first scan: "fusing" is published just before, and a moment later
+  // the first between-scans check has passed, seconds before the scan ends.
   std::string SubmitAndWaitForFusion(rpc::MapBuilderClient& client) {
     std::vector<std::string> ids;
     for (int seed = 0; seed < 2; ++seed) {
@@ -57,7 +58,7 @@ class LongFusion : public ServerTest {
     const v1::Job fusing = PollJob(
         client, job_id, [](const v1::Job& j) { return j.stage() == "fusing"; }, 300);
     EXPECT_EQ(fusing.stage(), "fusing") << fusing.error();
-    std::this_thread::sleep_for(std::chrono::seconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
     return job_id;
   }
 };
