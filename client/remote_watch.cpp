@@ -58,6 +58,11 @@ std::string FormatDuration(double seconds) {
   return text;
 }
 
+std::string GapLine(uint32_t skipped) {
+  return "watch fell behind: " + std::to_string(skipped) + " finished pair" +
+         (skipped == 1 ? "" : "s") + " not shown (boicp show lists every pair)";
+}
+
 std::string ProgressBar(uint32_t done, uint32_t total, int width) {
   const double fraction = total > 0 ? std::min(1.0, static_cast<double>(done) / total) : 0.0;
   const int filled = static_cast<int>(fraction * width);
@@ -97,6 +102,10 @@ ProgressPrinter::ProgressPrinter(bool terminal, std::chrono::milliseconds min_in
 
 void ProgressPrinter::OnEvent(const v1::JobEvent& event) {
   const v1::Job& job = event.job();
+  if (event.pairs_skipped() > 0) {
+    Finish();
+    std::fprintf(stderr, "%s\n", GapLine(event.pairs_skipped()).c_str());
+  }
   if (!first_pairs_done_) first_pairs_done_ = job.pairs_done();
   if (event.has_pair()) last_pair_ = event.pair();
   // The rate counts only pairs finished while watching: a resumed or

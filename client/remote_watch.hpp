@@ -19,6 +19,7 @@ class ProgressPrinter {
   /// most one every `min_interval` unless the stage changes.
   explicit ProgressPrinter(bool terminal,
                            std::chrono::milliseconds min_interval = std::chrono::seconds(5));
+  /// Prints a GapLine first when the event carries a gap marker.
   void OnEvent(const v1::JobEvent& event);
   /// Ends the redrawn line, so that what follows starts on a fresh one.
   void Finish();
@@ -40,6 +41,11 @@ class ProgressPrinter {
 /// `pairs_per_min` < 0 = unknown.
 std::string ProgressLine(const v1::Job& job, const std::optional<v1::PairResult>& last_pair,
                          double pairs_per_min);
+
+/// The gap marker of an event that says `skipped` finished pairs were merged
+/// away: "watch fell behind: 12 finished pairs not shown (boicp results
+/// lists every pair)".
+std::string GapLine(uint32_t skipped);
 
 /// "[#####...............]": done of total in `width` characters.
 std::string ProgressBar(uint32_t done, uint32_t total, int width = 20);

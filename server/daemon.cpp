@@ -53,8 +53,9 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
                                             options_.max_upload_bytes_in_flight);
+  idle_uploads_ = std::make_unique<IdleUploads>(std::chrono::seconds(options_.upload_idle_s));
   service_ = std::make_unique<MapBuilderService>(
-      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_,
+      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *idle_uploads_,
                   options_.max_scan_bytes, options_.max_scan_points, min_free_bytes});
 
   grpc::EnableDefaultHealthCheckService(true);

@@ -10,6 +10,7 @@
 #include "auth.hpp"
 #include "daemon_options.hpp"
 #include "data_dir.hpp"
+#include "idle_uploads.hpp"
 #include "job_manager.hpp"
 #include "job_store.hpp"
 #include "service.hpp"
@@ -47,6 +48,7 @@ class Daemon {
   std::unique_ptr<WatchHub> watches_;
   std::unique_ptr<JobManager> manager_;
   std::unique_ptr<UploadBudget> uploads_;
+  std::unique_ptr<IdleUploads> idle_uploads_;  // outlives the server: its uploads leave it
   std::unique_ptr<MapBuilderService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::string address_;

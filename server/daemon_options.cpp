@@ -77,6 +77,10 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "Seconds a connection without calls stays open")
       ->capture_default_str()
       ->envname("BOICPD_IDLE_CONNECTION");
+  app.add_option("--upload-idle-timeout", o.upload_idle_s,
+                 "Seconds an upload may send nothing before it is cancelled")
+      ->capture_default_str()
+      ->envname("BOICPD_UPLOAD_IDLE_TIMEOUT");
   app.add_option("--auth-token-file", o.auth_token_file,
                  "Require 'authorization: Bearer <token>' with the token in this file")
       ->envname("BOICPD_AUTH_TOKEN_FILE");
@@ -120,6 +124,7 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.grpc_memory_mb >= 16, "--grpc-memory-mb must be at least 16");
   require(o.keepalive_s >= 1 && o.keepalive_timeout_s >= 1 && o.idle_connection_s >= 1,
           "--keepalive, --keepalive-timeout and --idle-connection must be at least 1 s");
+  require(o.upload_idle_s >= 1, "--upload-idle-timeout must be at least 1 s");
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "critical"};
   require(std::find(levels.begin(), levels.end(), o.log_level) != levels.end(),
           "--log-level must be trace, debug, info, warn, error or critical");

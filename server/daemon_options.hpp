@@ -27,6 +27,7 @@ struct DaemonOptions {
   int keepalive_s = 60;                              // ping an idle connection this often
   int keepalive_timeout_s = 20;                      // and close it when the ping is not answered
   int idle_connection_s = 600;                       // close a connection with no call this long
+  int upload_idle_s = 60;  // cancel an upload that sends nothing this long
   std::string auth_token_file;
   std::string tls_cert, tls_key;
   std::string tls_client_ca;      // require client certificates signed by this CA (mutual TLS)

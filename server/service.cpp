@@ -55,7 +55,7 @@ std::optional<v1::Job> FindJob(const ServiceDeps& deps, const std::string& job_i
 
 grpc::ServerReadReactor<v1::UploadScanRequest>* MapBuilderService::UploadScan(
     grpc::CallbackServerContext* context, v1::UploadScanResponse* response) {
-  return new UploadReactor(deps_, response, deps_.auth.Check(*context));
+  return new UploadReactor(deps_, context, response, deps_.auth.Check(*context));
 }
 
 grpc::ServerUnaryReactor* MapBuilderService::FindScans(grpc::CallbackServerContext* context,

@@ -8,6 +8,7 @@
 #include "auth.hpp"
 #include "boicp/v1/map_builder.grpc.pb.h"
 #include "data_dir.hpp"
+#include "idle_uploads.hpp"
 #include "job_manager.hpp"
 #include "job_store.hpp"
 #include "upload_budget.hpp"
@@ -24,6 +25,7 @@ struct ServiceDeps {
   WatchHub& watches;
   const BearerAuth& auth;
   UploadBudget& uploads;
+  IdleUploads& idle_uploads;
   uint64_t max_scan_bytes = 0;   // larger uploads are RESOURCE_EXHAUSTED
   uint64_t max_scan_points = 0;  // scans decoding to more points are RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;   // below it uploads and batches are FAILED_PRECONDITION

@@ -2,7 +2,9 @@
 // How many uploads may stream at once and how many bytes they may announce
 // together. Each upload holds a ticket from its metadata to its end, so the
 // uploads in flight never pass either limit, and the free-space check of a
-// new upload counts the bytes the others still have to write.
+// new upload counts the bytes the others still have to write. An upload that
+// reuses stored bytes holds their size while it re-reads them; the
+// free-space check counts those too, which errs on the safe side.
 
 #include <cstdint>
 #include <mutex>

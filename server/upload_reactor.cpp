@@ -1,6 +1,7 @@
 #include "upload_reactor.hpp"
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 
@@ -57,17 +58,27 @@ bool SameDecoding(const v1::ScanMetadata& a, const v1::ScanMetadata& b) {
 
 }  // namespace
 
-UploadReactor::UploadReactor(const ServiceDeps& deps, v1::UploadScanResponse* response,
-                             const grpc::Status& auth)
+UploadReactor::UploadReactor(const ServiceDeps& deps, grpc::CallbackServerContext* context,
+                             v1::UploadScanResponse* response, const grpc::Status& auth)
     : deps_(deps), response_(response) {
   if (!auth.ok()) {
     FinishUpload(auth);
     return;
   }
+  idle_id_ = deps_.idle_uploads.Enter(context);
   StartRead(&request_);
 }
 
 void UploadReactor::OnReadDone(bool ok) {
+  if (ok) deps_.idle_uploads.Touch(idle_id_);
+  if (!ok && deps_.idle_uploads.TimedOut(idle_id_)) {
+    const auto seconds =
+        std::chrono::duration_cast<std::chrono::seconds>(deps_.idle_uploads.timeout()).count();
+    FinishUpload(grpc::Status(
+        grpc::StatusCode::DEADLINE_EXCEEDED,
+        "the upload sent nothing for " + std::to_string(seconds) + " s (--upload-idle-timeout)"));
+    return;
+  }
   const grpc::Status status = GuardRpc("UploadScan", [&] {
     if (ok) {
       Accept(request_);
@@ -91,6 +102,7 @@ void UploadReactor::FinishUpload(const grpc::Status& status) {
 }
 
 void UploadReactor::OnDone() {
+  if (idle_id_ != 0) deps_.idle_uploads.Leave(idle_id_);
   if (temp_.is_open()) temp_.close();
   if (!temp_path_.empty()) {
     std::error_code ignored;
@@ -115,8 +127,7 @@ void UploadReactor::Accept(const v1::UploadScanRequest& request) {
 void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
   if (metadata_) throw InputError("metadata may only be sent once, first");
   ValidateScanMetadata(metadata);
-  known_ = !metadata.sha256().empty() && deps_.store.GetScan(metadata.sha256()) &&
-           deps_.data_dir.HasScanFile(metadata.sha256()) && StoredCopyIntact(metadata.sha256());
+  known_ = ReuseStoredCopy(metadata);
   if (!known_) {
     if (metadata.size_bytes() == 0) {
       throw InputError("metadata.size_bytes is required (the number of bytes that follow)");
@@ -127,12 +138,11 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
                              " bytes is over this daemon's limit of " +
                              std::to_string(deps_.max_scan_bytes) + " (--max-scan-bytes)");
     }
-  }
-  // The other uploads in flight still have their announced bytes to write.
-  const uint64_t incoming = known_ ? 0 : metadata.size_bytes();
-  RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight() + incoming);
-  ticket_.emplace(deps_.uploads, incoming);
-  if (!known_) {
+    ticket_.reset();  // a stored copy that failed its check: the bytes come now
+    // The other uploads in flight still have their announced bytes to write.
+    RequireStorage(deps_.data_dir, deps_.min_free_bytes,
+                   deps_.uploads.bytes_in_flight() + metadata.size_bytes());
+    ticket_.emplace(deps_.uploads, metadata.size_bytes());
     temp_path_ = deps_.data_dir.NewTempPath();
     temp_.open(temp_path_, std::ios::binary | std::ios::trunc);
     if (!temp_) {
@@ -140,6 +150,15 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
     }
   }
   metadata_ = metadata;
+}
+
+bool UploadReactor::ReuseStoredCopy(const v1::ScanMetadata& metadata) {
+  if (metadata.sha256().empty()) return false;
+  const std::optional<StoredScan> stored = deps_.store.GetScan(metadata.sha256());
+  if (!stored || !deps_.data_dir.HasScanFile(metadata.sha256())) return false;
+  RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight());
+  ticket_.emplace(deps_.uploads, stored->metadata.size_bytes());
+  return StoredCopyIntact(metadata.sha256());
 }
 
 bool UploadReactor::StoredCopyIntact(const std::string& scan_id) {

@@ -4,7 +4,8 @@
 // core loaders (so a malformed scan is refused at upload, not mid-batch),
 // then renamed to its hash and recorded. Refused (FAILED_PRECONDITION) while
 // the data directory cannot take the announced bytes with those of the other
-// uploads in flight, and (RESOURCE_EXHAUSTED) over the upload budget.
+// uploads in flight, and (RESOURCE_EXHAUSTED) over the upload budget, which
+// an upload reusing stored bytes is charged their size in too.
 
 #include <fstream>
 #include <optional>
@@ -22,9 +23,10 @@ struct ServiceDeps;
 
 class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequest> {
  public:
-  /// Finishes at once with `auth` unless it is OK.
-  UploadReactor(const ServiceDeps& deps, ::boicp::v1::UploadScanResponse* response,
-                const grpc::Status& auth);
+  /// Finishes at once with `auth` unless it is OK; otherwise the upload is
+  /// cancelled once it sends nothing for deps.idle_uploads' timeout.
+  UploadReactor(const ServiceDeps& deps, grpc::CallbackServerContext* context,
+                ::boicp::v1::UploadScanResponse* response, const grpc::Status& auth);
 
   void OnReadDone(bool ok) override;
   void OnDone() override;
@@ -37,6 +39,12 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   /// Frees the upload's slot and bytes in the budget, then finishes: a client
   /// that has heard this upload end is never refused because of it.
   void FinishUpload(const grpc::Status& status);
+  /// Whether the client may skip the bytes: the store holds an intact copy
+  /// of the hash it names. The check re-reads (and the upload's end may
+  /// re-parse) the stored bytes on this thread, so it first takes a slot and
+  /// the stored size in the upload budget, as an upload of those bytes would:
+  /// a few bytes of metadata cannot start unbounded work.
+  bool ReuseStoredCopy(const ::boicp::v1::ScanMetadata& metadata);
   /// Verifies the stored copy a client wants to reuse; false (and the reason
   /// in corruption_) when it failed its hash check.
   bool StoredCopyIntact(const std::string& scan_id);
@@ -52,6 +60,7 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   std::ofstream temp_;
   Sha256 hash_;
   uint64_t received_ = 0;
+  uint64_t idle_id_ = 0;  // in deps_.idle_uploads; 0 = not timed
 };
 
 }  // namespace boicp::server

@@ -1,17 +1,14 @@
 #include "watch_hub.hpp"
 
-#include <deque>
 #include <vector>
 
 #include "rpc_names.hpp"
+#include "watch_queue.hpp"
 
 namespace boicp::server {
 namespace {
 
-// Events one watcher may have queued. A watcher that reads slower than the
-// job reports gets, past this, the newest snapshot in place of the last
-// queued event: a finished pair's event may give way (the pair stays in
-// GetResults, and pairs_done shows the jump), the final state never does.
+// Events one watcher may have queued (WatchQueue says what gives way past it).
 constexpr size_t kMaxPendingEvents = 64;
 
 }  // namespace
@@ -49,21 +46,6 @@ class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
     status = s;
   }
 
-  void Enqueue(const v1::JobEvent& event) {
-    // Progress snapshots without a pair result supersede each other within a
-    // stage, so a slow client gets the newest state instead of an ever longer
-    // backlog, yet still sees every stage begin.
-    if (!pending.empty() && !pending.back().has_pair() && !event.has_pair() &&
-        pending.back().job().stage() == event.job().stage()) {
-      pending.back() = event;
-    } else if (pending.size() >= kMaxPendingEvents) {
-      pending.back() = event;
-      pending.back().clear_pair();
-    } else {
-      pending.push_back(event);
-    }
-  }
-
   void Wake() {
     hub_.work_ = true;
     hub_.wake_.notify_one();
@@ -71,7 +53,7 @@ class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
 
   WatchHub& hub_;
   const std::string job_id;
-  std::deque<v1::JobEvent> pending;
+  WatchQueue pending{kMaxPendingEvents};
   v1::JobEvent current;  // the event being written; untouched while writing
   bool registered = false;
   bool writing = false;
@@ -105,7 +87,7 @@ void WatchHub::Publish(const v1::JobEvent& event) {
   }
   for (Stream* stream : streams_) {
     if (stream->job_id == event.job().job_id() && !stream->finish_requested) {
-      stream->Enqueue(event);
+      stream->pending.Push(event);
     }
   }
   work_ = true;
@@ -136,7 +118,7 @@ grpc::ServerWriteReactor<v1::JobEvent>* WatchHub::StartWatch(const std::string& 
   stream->registered = true;
   v1::JobEvent first;
   *first.mutable_job() = *snapshot;
-  stream->pending.push_back(first);
+  stream->pending.Push(first);
   streams_.push_back(stream);
   work_ = true;
   wake_.notify_one();
@@ -147,7 +129,7 @@ void WatchHub::CloseAll(const grpc::Status& status) {
   std::lock_guard<std::mutex> lock(mutex_);
   for (Stream* stream : streams_) {
     if (!stream->finish_requested) {
-      stream->pending.clear();
+      stream->pending.Clear();
       stream->RequestFinish(status);
     }
   }
@@ -179,8 +161,7 @@ void WatchHub::Pump() {
         s->finish_called = true;
         actions.push_back({s, true, s->status});
       } else if (!s->pending.empty()) {
-        s->current = std::move(s->pending.front());
-        s->pending.pop_front();
+        s->current = s->pending.Pop();
         s->writing = true;
         if (IsTerminal(s->current.job().state())) s->RequestFinish(grpc::Status::OK);
         actions.push_back({s, false, {}});

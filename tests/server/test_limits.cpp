@@ -2,7 +2,10 @@
 // limit's value and its flag in the message, while a request at the limit
 // still passes.
 
+#include <sys/statvfs.h>
+
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <thread>
 
@@ -180,44 +183,165 @@ TEST_F(Limits, LabelsAreEscapedInTheLog) {
   EXPECT_EQ(client.GetJob(job_id).label(), request.label()) << "the label itself is kept";
 }
 
+// An upload the server has read the metadata of, held open (no bytes, no
+// end), so that it keeps its slot and its announced bytes in the budget.
+struct HeldUpload {
+  std::unique_ptr<grpc::ClientContext> context;
+  v1::UploadScanResponse response;
+  std::unique_ptr<grpc::ClientWriter<v1::UploadScanRequest>> writer;
+
+  grpc::Status End() {
+    if (!writer) return grpc::Status::OK;
+    writer->WritesDone();
+    const grpc::Status status = writer->Finish();
+    writer.reset();
+    return status;
+  }
+};
+
+// Ends what `held` held and opens an upload of `metadata` in it (the
+// metadata sent, then a pause for the server to read it).
+void Hold(rpc::MapBuilderClient& client, const v1::ScanMetadata& metadata, HeldUpload& held) {
+  held.End();
+  held.context = std::make_unique<grpc::ClientContext>();
+  held.writer = client.stub().UploadScan(held.context.get(), &held.response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = metadata;
+  held.writer->Write(message);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+}
+
+// Holds an upload of `metadata` open in `held` and runs `probe`, starting
+// over until the probe fails, at most 50 times: the server may read the
+// probe's metadata before the held one's, and then the held upload is the
+// one refused. Returns the probe's last status.
+grpc::Status ProbeWhileHeld(rpc::MapBuilderClient& client, const v1::ScanMetadata& metadata,
+                            const std::function<grpc::Status()>& probe, HeldUpload& held) {
+  grpc::Status status;
+  for (int attempt = 0; attempt < 50 && status.ok(); ++attempt) {
+    Hold(client, metadata, held);
+    status = probe();
+  }
+  return status;
+}
+
 // Uploads streaming at once are bounded, in number and in announced bytes.
 TEST_F(Limits, UploadsInFlight) {
   StartDaemon(
       {"--workers", "1", "--max-concurrent-uploads", "1", "--max-upload-bytes-in-flight", "1000"});
   auto client = Client();
-  v1::UploadScanRequest message;
-  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, XyzScan(3).size());
-  // An upload holds the one slot once the server has read its metadata. Until
-  // then a second upload may take the slot first, and the open one is the
-  // upload refused; so open one, give the server a moment, probe, and start
-  // over (ending the open one) until the probe is the upload refused.
-  v1::UploadScanResponse response;
-  std::unique_ptr<grpc::ClientContext> context;
-  std::unique_ptr<grpc::ClientWriter<v1::UploadScanRequest>> open_upload;
-  grpc::Status status;
-  for (int attempt = 0; attempt < 50 && status.ok(); ++attempt) {
-    if (open_upload) {
-      open_upload->WritesDone();
-      open_upload->Finish();
-    }
-    context = std::make_unique<grpc::ClientContext>();
-    open_upload = client.stub().UploadScan(context.get(), &response);
-    ASSERT_TRUE(open_upload->Write(message));
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)});
-  }
+  HeldUpload held;
+  grpc::Status status = ProbeWhileHeld(
+      client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(3).size()),
+      [&] { return RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)}); },
+      held);
   EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("(--max-concurrent-uploads 1)"));
+  v1::UploadScanRequest message;
   message.set_chunk(XyzScan(3));
-  ASSERT_TRUE(open_upload->Write(message));
-  open_upload->WritesDone();
-  EXPECT_TRUE(open_upload->Finish().ok()) << "the upload holding the slot completes";
+  ASSERT_TRUE(held.writer->Write(message));
+  EXPECT_TRUE(held.End().ok()) << "the upload holding the slot completes";
 
   const std::string big = XyzScan(200);  // over 1000 bytes
   status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, big.size()), {big});
   EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("(--max-upload-bytes-in-flight)"));
   EXPECT_TRUE(RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)}).ok());
+}
+
+// A metadata-only upload naming a stored scan makes the daemon re-hash (and
+// may make it re-parse) the stored bytes: it is charged their size in the
+// budget, so a few bytes cannot start more work than uploads of the bytes.
+TEST_F(Limits, ReusingStoredBytesCountsTheirSizeInTheBudget) {
+  StartDaemon({"--workers", "1", "--max-upload-bytes-in-flight", "1000"});
+  auto client = Client();
+  const std::string stored = XyzScan(100);  // 690 bytes
+  const std::string id = client.Upload(stored, Meta(v1::SCAN_FORMAT_XYZ, stored.size())).scan_id();
+  v1::ScanMetadata reuse = Meta(v1::SCAN_FORMAT_XYZ, stored.size());
+  reuse.set_sha256(id);
+  HeldUpload held;  // announces 500 bytes: 690 more is over 1000
+  const grpc::Status status = ProbeWhileHeld(
+      client, Meta(v1::SCAN_FORMAT_XYZ, 500), [&] { return RawUpload(client, reuse, {}); }, held);
+  EXPECT_EQ(status.error_code(), Code::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("690 more"));
+  held.End();
+  EXPECT_TRUE(RawUpload(client, reuse, {}).ok()) << "alone, the reuse fits";
+}
+
+// Uploads in flight cannot together pass the free-space check: each one
+// counts the bytes the others announced and have yet to write. The reserve
+// leaves 8 GiB free for uploads; two of 4.8 GiB do not fit. (Other work on
+// the disk may move its free space by up to 1.6 GiB without changing that.)
+TEST_F(Limits, ConcurrentUploadsCannotTogetherPassTheFreeSpaceCheck) {
+  struct statvfs fs {};
+  ASSERT_EQ(::statvfs(dir_.c_str(), &fs), 0);
+  const uint64_t free_bytes = static_cast<uint64_t>(fs.f_bavail) * fs.f_frsize;
+  constexpr uint64_t kHeadroom = 8ull << 30;
+  if (free_bytes < kHeadroom + (4ull << 30)) {
+    GTEST_SKIP() << "needs 12 GiB free beside the data directory, " << (free_bytes >> 20)
+                 << " MiB are";
+  }
+  const uint64_t each = kHeadroom / 10 * 6;
+  StartDaemon({"--workers", "1", "--min-free-mb", std::to_string((free_bytes - kHeadroom) >> 20),
+               "--max-scan-bytes", std::to_string(each), "--max-upload-bytes-in-flight",
+               std::to_string(4 * each)});
+  auto client = Client();
+  // Announced but never sent: a probe that passes the check ends with
+  // INVALID_ARGUMENT (no bytes came), one refused by it FAILED_PRECONDITION.
+  const auto probe = [&] {
+    const grpc::Status status = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, each), {});
+    return status.error_code() == Code::INVALID_ARGUMENT ? grpc::Status::OK : status;
+  };
+  HeldUpload held;
+  const grpc::Status status = ProbeWhileHeld(client, Meta(v1::SCAN_FORMAT_XYZ, each), probe, held);
+  EXPECT_EQ(status.error_code(), Code::FAILED_PRECONDITION) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("(--min-free-mb "));
+  held.End();
+  EXPECT_TRUE(probe().ok()) << "alone, an upload of the same size passes the check";
+}
+
+// One connection carries at most --max-concurrent-streams calls at once: a
+// call waits while two open uploads hold the connection's two streams, and
+// goes through once one of them ends.
+TEST_F(Limits, ConcurrentStreamsPerConnection) {
+  StartDaemon({"--workers", "1", "--max-concurrent-streams", "2"});
+  auto client = Client();
+  const auto get_job = [&client](int deadline_s) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(deadline_s));
+    v1::GetJobRequest request;
+    request.set_job_id("job-999999");
+    v1::Job job;
+    return client.stub().GetJob(&context, request, &job).error_code();
+  };
+  // Connects, so that the client knows the server's stream limit.
+  const grpc::StatusCode answered = get_job(60);
+  ASSERT_EQ(answered, Code::NOT_FOUND);
+  HeldUpload first, second;
+  Hold(client, Meta(v1::SCAN_FORMAT_XYZ, 10), first);
+  Hold(client, Meta(v1::SCAN_FORMAT_XYZ, 10), second);
+  EXPECT_EQ(get_job(2), Code::DEADLINE_EXCEEDED) << "a third call on the connection went through";
+  first.End();
+  EXPECT_EQ(get_job(60), answered);
+}
+
+// An upload that sends its metadata and then nothing, on a connection that
+// stays alive, is cancelled after --upload-idle-timeout, and its slot is
+// free again. (The client's own deadline, far later, ends it otherwise.)
+TEST_F(Limits, SilentUploadIsCancelled) {
+  StartDaemon({"--workers", "1", "--max-concurrent-uploads", "1", "--upload-idle-timeout", "1"});
+  auto client = Client();
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  v1::UploadScanResponse response;
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, 100);
+  ASSERT_TRUE(writer->Write(message));
+  const grpc::Status status = writer->Finish();  // the client sends nothing more
+  EXPECT_EQ(status.error_code(), Code::CANCELLED) << status.error_message();
+  EXPECT_TRUE(RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)}).ok())
+      << "the slot is free again";
 }
 
 }  // namespace

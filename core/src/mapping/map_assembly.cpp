@@ -39,10 +39,12 @@ struct PreparedScan {
 };
 
 PreparedScan PrepareScan(const OccupancyMap& map, const ScanSource& scan, const Transform& pose,
-                         const MapBuildSettings& settings, bool want_cloud) {
+                         const MapBuildSettings& settings, bool want_cloud,
+                         const MapStopRequest& stop) {
   PreparedScan prepared;
   Points points = LoadPointCloud(scan.path, scan.load).points;
-  prepared.update = map.ComputeUpdate(points, pose, scan.sensor_origin, settings.fusion_threads);
+  prepared.update =
+      map.ComputeUpdate(points, pose, scan.sensor_origin, settings.fusion_threads, stop);
   if (want_cloud) {
     prepared.cloud_points = WithinRange(points, scan.sensor_origin, settings.occupancy.max_range);
   }
@@ -110,18 +112,21 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
 
   const auto prepare = [&](int i) {
     const auto index = static_cast<size_t>(i);
-    return PrepareScan(map, scans[index], poses[index], settings, want_cloud);
+    return PrepareScan(map, scans[index], poses[index], settings, want_cloud,
+                       callbacks.stop_requested);
   };
   // A two-stage pipeline: scan i+1 is loaded and ray cast on a helper thread
   // while this thread applies scan i to the tree, in scan order. Whether the
-  // helper exists changes only timing, never the tree.
+  // helper exists changes only timing, never the tree. A stop request ends
+  // the ray casting, the tree update and the tree writes from inside, so a
+  // large scan or map does not hold a cancel or a drain back.
   const bool pipelined = settings.fusion_threads > 1;
   std::future<PreparedScan> next;
   for (int i = 0; i < total; ++i) {
     ThrowIfStopped(callbacks);
     PreparedScan current = next.valid() ? next.get() : prepare(i);
     if (pipelined && i + 1 < total) next = std::async(std::launch::async, prepare, i + 1);
-    map.ApplyUpdate(current.update);
+    map.ApplyUpdate(current.update, callbacks.stop_requested);
     if (want_cloud) cloud.Add(current.cloud_points, poses[static_cast<size_t>(i)]);
     Report(callbacks, "fusing", i + 1, total);
   }
@@ -131,14 +136,19 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   FusionSummary summary;
   summary.occupied_leaves = map.OccupiedLeaves();
   // The .ot keeps full probabilities, so it goes before the .bt conversion.
-  // A stop request is honoured between outputs too: each write is atomic,
-  // so a stopped job leaves whole files, and its rerun rewrites them all.
+  // A stop request is honoured during and between outputs too: each write
+  // is atomic, so a stopped job leaves whole files, and its rerun rewrites
+  // them all.
   if (!outputs.octomap_ot.empty()) {
-    WriteFileAtomically(outputs.octomap_ot, [&](const std::string& tmp) { map.WriteFull(tmp); });
+    WriteFileAtomically(outputs.octomap_ot, [&](const std::string& tmp) {
+      map.WriteFull(tmp, callbacks.stop_requested);
+    });
   }
   ThrowIfStopped(callbacks);
   if (!outputs.octomap_bt.empty()) {
-    WriteFileAtomically(outputs.octomap_bt, [&](const std::string& tmp) { map.WriteBinary(tmp); });
+    WriteFileAtomically(outputs.octomap_bt, [&](const std::string& tmp) {
+      map.WriteBinary(tmp, callbacks.stop_requested);
+    });
   }
   ThrowIfStopped(callbacks);
   if (!outputs.trajectory_tum.empty()) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <octomap/OcTree.h>
 
 #include "boicp/util/parallel_for.hpp"
+#include "stoppable_output.hpp"
 
 namespace boicp {
 namespace {
@@ -22,6 +24,31 @@ using octomap::point3d;
 void Require(bool ok, const std::string& message) {
   if (!ok) throw InputError("map settings: " + message);
 }
+
+// How often long loops poll a stop request: a ray crosses up to tens of
+// thousands of cells, a tree update touches one node per cell, and either
+// count keeps a stop within a small fraction of a second of its request.
+constexpr size_t kRaysPerStopPoll = 64;
+constexpr size_t kCellsPerStopPoll = 16384;
+
+// A stop request shared by the threads of one ray cast: the first to see it
+// fired tells the others, which then return at their next poll.
+class SharedStop {
+ public:
+  explicit SharedStop(const MapStopRequest& request) : request_(request) {}
+
+  bool Poll() {
+    if (fired_.load(std::memory_order_relaxed)) return true;
+    if (request_ && request_()) fired_.store(true, std::memory_order_relaxed);
+    return fired_.load(std::memory_order_relaxed);
+  }
+
+  bool fired() const { return fired_.load(std::memory_order_relaxed); }
+
+ private:
+  const MapStopRequest& request_;
+  std::atomic<bool> fired_{false};
+};
 
 // An OcTree whose updates skip OctoMap's early-abort search. updateNode
 // first searches the key and returns if its leaf is already clamped in the
@@ -169,8 +196,10 @@ std::vector<point3d> DiscretisedEndpoints(const octomap::OcTree& tree,
 // Casts the rays to endpoints [begin, end) as OctoMap's computeUpdate does
 // without a bounding box: cells along a ray are free, its endpoint occupied;
 // a ray longer than max_range (when >= 0) is cut there and marks no endpoint.
+// Returns early, with the cells incomplete, once `stop` fires.
 void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints, size_t begin,
-              size_t end, const point3d& origin, double max_range, ShardedCells& cells) {
+              size_t end, const point3d& origin, double max_range, ShardedCells& cells,
+              SharedStop& stop) {
   const size_t shards = cells.free.size();
   octomap::KeyRay ray;
   const auto mark_free = [&] {
@@ -179,6 +208,7 @@ void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints
     }
   };
   for (size_t i = begin; i < end; ++i) {
+    if ((i - begin) % kRaysPerStopPoll == 0 && stop.Poll()) return;
     const point3d& p = endpoints[i];
     if (max_range < 0.0 || (p - origin).norm() <= max_range) {
       if (tree.computeRayKeys(origin, p, ray)) mark_free();
@@ -276,7 +306,8 @@ void OccupancyMap::InsertScan(const Points& points, const Transform& T_map_scan,
 }
 
 ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_map_scan,
-                                       const Point& sensor_origin, int threads) const {
+                                       const Point& sensor_origin, int threads,
+                                       const MapStopRequest& stop) const {
   const octomap::OcTree& tree = impl_->tree;
   const std::vector<point3d> endpoints = DiscretisedEndpoints(tree, ToMapFrame(points, T_map_scan));
   const Point origin_d =
@@ -289,11 +320,13 @@ ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_
   const size_t chunk_count = std::max<size_t>(1, std::min(workers, endpoints.size()));
   const size_t shards = workers;
   std::vector<ShardedCells> chunks(chunk_count, ShardedCells(shards));
+  SharedStop shared_stop(stop);
   ParallelFor(chunk_count, threads, [&](size_t c) {
     const size_t begin = endpoints.size() * c / chunk_count;
     const size_t end = endpoints.size() * (c + 1) / chunk_count;
-    CastRays(tree, endpoints, begin, end, origin, max_range, chunks[c]);
+    CastRays(tree, endpoints, begin, end, origin, max_range, chunks[c], shared_stop);
   });
+  if (shared_stop.fired()) throw Cancelled();
 
   ScanUpdate update;
   update.impl_ = std::make_unique<ScanUpdate::Impl>(shards);
@@ -301,15 +334,20 @@ ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_
   return update;
 }
 
-void OccupancyMap::ApplyUpdate(const ScanUpdate& update) {
+void OccupancyMap::ApplyUpdate(const ScanUpdate& update, const MapStopRequest& stop) {
   FusionOcTree& tree = impl_->tree;
+  impl_->inner_dirty = true;
+  size_t cells = 0;
+  const auto update_cell = [&](const OcTreeKey& key, bool occupied) {
+    if (++cells % kCellsPerStopPoll == 0 && stop && stop()) throw Cancelled();
+    tree.Update(key, occupied);
+  };
   for (const CellSet& shard : update.impl_->cells.free) {
-    shard.ForEach([&](const OcTreeKey& key) { tree.Update(key, /*occupied=*/false); });
+    shard.ForEach([&](const OcTreeKey& key) { update_cell(key, /*occupied=*/false); });
   }
   for (const KeySet& shard : update.impl_->cells.occupied) {
-    for (const OcTreeKey& key : shard) tree.Update(key, /*occupied=*/true);
+    for (const OcTreeKey& key : shard) update_cell(key, /*occupied=*/true);
   }
-  impl_->inner_dirty = true;
 }
 
 size_t OccupancyMap::OccupiedLeaves() {
@@ -321,22 +359,35 @@ size_t OccupancyMap::OccupiedLeaves() {
   return count;
 }
 
-// The stream overloads, because OctoMap's file-name overloads print progress
-// to stdout, which is the daemon's log.
-void OccupancyMap::WriteFull(const std::string& path) {
-  impl_->UpdateInner();
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out || !impl_->tree.write(out) || !out.flush()) {
-    throw std::runtime_error(path + ": cannot write OctoMap .ot");
+namespace {
+
+// Writes through OctoMap's stream overloads, because its file-name overloads
+// print progress to stdout, which is the daemon's log.
+void WriteTree(const std::string& path, const std::string& kind, const MapStopRequest& stop,
+               const std::function<bool(std::ostream&)>& write) {
+  std::filebuf file;
+  if (!file.open(path, std::ios::out | std::ios::binary | std::ios::trunc)) {
+    throw std::runtime_error(path + ": cannot write OctoMap " + kind);
+  }
+  StoppableOutput stoppable(file, stop);
+  std::ostream out(&stoppable);
+  const bool written = write(out) && out.flush();
+  if (stoppable.stopped()) throw Cancelled();
+  if (!written || file.close() == nullptr) {
+    throw std::runtime_error(path + ": cannot write OctoMap " + kind);
   }
 }
 
-void OccupancyMap::WriteBinary(const std::string& path) {
+}  // namespace
+
+void OccupancyMap::WriteFull(const std::string& path, const MapStopRequest& stop) {
   impl_->UpdateInner();
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out || !impl_->tree.writeBinary(out) || !out.flush()) {
-    throw std::runtime_error(path + ": cannot write OctoMap .bt");
-  }
+  WriteTree(path, ".ot", stop, [&](std::ostream& out) { return impl_->tree.write(out); });
+}
+
+void OccupancyMap::WriteBinary(const std::string& path, const MapStopRequest& stop) {
+  impl_->UpdateInner();
+  WriteTree(path, ".bt", stop, [&](std::ostream& out) { return impl_->tree.writeBinary(out); });
 }
 
 }  // namespace boicp

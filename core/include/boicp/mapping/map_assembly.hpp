@@ -73,7 +73,10 @@ struct AssemblyProgress {
 
 struct AssemblyCallbacks {
   std::function<void(const AssemblyProgress&)> progress;
-  std::function<bool()> stop_requested;  // polled between scans; true -> boicp::Cancelled
+  /// Polled between scans and inside each scan's ray casting, tree update
+  /// and tree writes (from several threads: it must be thread-safe); true
+  /// -> boicp::Cancelled.
+  MapStopRequest stop_requested;
 };
 
 struct FusionSummary {

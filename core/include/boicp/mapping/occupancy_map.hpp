@@ -4,6 +4,7 @@
 // headers.
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -25,6 +26,11 @@ struct OccupancySettings {
 
 /// Throws InputError naming the first invalid field.
 void ValidateOccupancySettings(const OccupancySettings& settings);
+
+/// Polled during long map work (ray casting, tree update, writing); true
+/// ends it with boicp::Cancelled. Called from several threads at once, so it
+/// must be thread-safe. Empty: never stops.
+using MapStopRequest = std::function<bool()>;
 
 /// The cells one scan marks free and occupied, ray cast but not yet applied
 /// to a map. Holds memory in proportion to the cells the scan touches.
@@ -63,26 +69,32 @@ class OccupancyMap {
   /// the calling one among them (< 1 counts as 1), without changing the map:
   /// it reads only the map's settings, so it may run while another thread
   /// applies an earlier update. The cells are the ones OctoMap's discretised
-  /// insertPointCloud updates, whatever the thread count.
+  /// insertPointCloud updates, whatever the thread count. Polls `stop` every
+  /// few hundred rays and throws Cancelled once it fires.
   ScanUpdate ComputeUpdate(const Points& points, const Transform& T_map_scan,
-                           const Point& sensor_origin, int threads) const;
+                           const Point& sensor_origin, int threads,
+                           const MapStopRequest& stop = {}) const;
 
   /// Applies an update computed by this map's ComputeUpdate: a miss for every
   /// free cell, then a hit for every occupied one. Each cell is in at most one
   /// of the two sets, so the tree does not depend on the order within a set
   /// and is bit-identical to OctoMap's own insertion of the same scan.
-  void ApplyUpdate(const ScanUpdate& update);
+  /// Polls `stop` every few ten thousand cells; a Cancelled thrown from it
+  /// leaves the map part-updated, fit only to be discarded.
+  void ApplyUpdate(const ScanUpdate& update, const MapStopRequest& stop = {});
 
   /// Number of leaves currently believed occupied (after inner nodes are updated).
   size_t OccupiedLeaves();
 
-  /// Writes the full-probability tree (.ot). Throws std::runtime_error on I/O failure.
-  void WriteFull(const std::string& path);
+  /// Writes the full-probability tree (.ot). Throws std::runtime_error on I/O
+  /// failure, Cancelled when `stop` fires during the write (the file at
+  /// `path` is then incomplete: write to a staging file).
+  void WriteFull(const std::string& path, const MapStopRequest& stop = {});
 
   /// Writes the maximum-likelihood, pruned binary tree (.bt). Converts the
-  /// tree in memory, so call WriteFull first when both are wanted. Throws
-  /// std::runtime_error on I/O failure.
-  void WriteBinary(const std::string& path);
+  /// tree in memory, so call WriteFull first when both are wanted. Throws as
+  /// WriteFull does.
+  void WriteBinary(const std::string& path, const MapStopRequest& stop = {});
 
  private:
   struct Impl;
