@@ -6,14 +6,16 @@
 
 namespace boicp::bench {
 
-BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input) {
+namespace {
+
+BoIcpConfig PresetForDataset(const std::string& preset, const MethodInput& input, bool automatic) {
   const BoIcpConfig preset_config = PresetConfig(preset);
   settings::RequestedSettings given;
   given.preset = preset;
   given.seed = input.seed;
   given.threads = input.threads;
   given.no_retry = !input.dataset.retry_when_doubtful;
-  if (!input.dataset.automatic_settings) {
+  if (!automatic) {
     given.fixed_settings = true;
     given.voxel = input.dataset.voxel * preset_config.voxel / PresetConfig("C").voxel;
     given.rotation_bounds = input.dataset.rotation_bounds;
@@ -25,6 +27,16 @@ BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input)
     given.iterations = std::min(preset_config.iterations, kQuickBoSamples);
   }
   return settings::ConfigFromSettings(given);
+}
+
+}  // namespace
+
+BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input) {
+  return PresetForDataset(preset, input, input.dataset.automatic_settings);
+}
+
+BoIcpConfig DatasetTableConfig(const std::string& preset, const MethodInput& input) {
+  return PresetForDataset(preset, input, false);
 }
 
 }  // namespace boicp::bench

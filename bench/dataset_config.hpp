@@ -21,4 +21,8 @@ constexpr int kQuickBoSamples = 10;
 /// choose from the pair. The input's seed and thread budget.
 BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input);
 
+/// As DatasetBoConfig, always with the dataset table's voxel and bounds: the
+/// baselines' settings, which --auto-settings leaves as they are.
+BoIcpConfig DatasetTableConfig(const std::string& preset, const MethodInput& input);
+
 }  // namespace boicp::bench

@@ -2,6 +2,7 @@
 """Fits the confidence model of core/src/registration/confidence.cpp on bench outcomes.
 
 usage: fit_confidence.py --fit CSV [CSV...] --test CSV [CSV...]
+       fit_confidence.py --check CSV [CSV...]
 
 Every CSV is a boicp-bench results.csv. Rows of the BO methods (those with
 the feature columns) are the samples, `success` the label. The model is a
@@ -9,7 +10,9 @@ logistic regression of success on fitness and margin, fitted by Newton's method 
 the --fit rows. It prints the weights as C++ constants, then for the --test
 rows (never used in the fit): the AUROC, the share of failures flagged
 doubtful (confidence < 0.5), the share of successes flagged, and a
-reliability table.
+reliability table. --check reports the same for the confidence the engine
+itself recorded in the rows (the shipped model, final answers after any
+retry), with no fit.
 """
 
 import argparse
@@ -28,14 +31,14 @@ CONSTANTS = ["kFitness", "kMargin"]
 RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
 
 
-def read_samples(paths):
+def read_samples(paths, columns=FEATURES):
     features, labels = [], []
     for path in paths:
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
                 if row["experiment"] != "suite" or row.get("fitness", "") == "":
                     continue
-                features.append([float(row[name]) for name in FEATURES])
+                features.append([float(row[name]) for name in columns])
                 labels.append(1.0 if row["success"] == "1" else 0.0)
     return np.array(features), np.array(labels)
 
@@ -68,24 +71,8 @@ def auroc(scores, labels):
     return (wins + 0.5 * ties) / (len(positives) * len(negatives))
 
 
-def main(argv):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--fit", nargs="+", required=True)
-    parser.add_argument("--test", nargs="+", required=True)
-    args = parser.parse_args(argv)
-    x_fit, y_fit = read_samples(args.fit)
-    x_test, y_test = read_samples(args.test)
-    if len(y_fit) == 0 or len(y_test) == 0:
-        sys.exit("fit_confidence.py: no BO rows with features in the --fit or --test files")
-    w = fit_logistic(x_fit, y_fit)
-    print(f"fitted on {len(y_fit)} runs ({int((1 - y_fit).sum())} failures)")
-    print(f"constexpr double kIntercept = {w[0]:.4g};")
-    for name, weight in zip(CONSTANTS, w[1:]):
-        print(f"constexpr double {name} = {weight:.4g};")
-
-    p = predict(w, x_test)
+def report(p, y_test):
     failures, successes = y_test == 0, y_test == 1
-    print(f"\ntested on {len(y_test)} other runs ({int(failures.sum())} failures)")
     print(f"AUROC {auroc(p, y_test):.3f}")
     if failures.any():
         print(f"failures flagged doubtful: {int((p[failures] < 0.5).sum())}/{int(failures.sum())}")
@@ -97,6 +84,35 @@ def main(argv):
         if inside.any():
             print(f"| {lo:.1f}-{min(hi, 1.0):.1f} | {int(inside.sum())} | {p[inside].mean():.3f} | "
                   f"{y_test[inside].mean():.3f} |")
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--fit", nargs="+")
+    parser.add_argument("--test", nargs="+")
+    parser.add_argument("--check", nargs="+")
+    args = parser.parse_args(argv)
+    if args.check:
+        confidence, y_check = read_samples(args.check, ["confidence"])
+        if len(y_check) == 0:
+            sys.exit("fit_confidence.py: no BO rows with features in the --check files")
+        print(f"{len(y_check)} runs ({int((1 - y_check).sum())} failures), recorded confidence")
+        report(confidence[:, 0], y_check)
+        return
+    if not args.fit or not args.test:
+        sys.exit("fit_confidence.py: give --fit and --test, or --check")
+    x_fit, y_fit = read_samples(args.fit)
+    x_test, y_test = read_samples(args.test)
+    if len(y_fit) == 0 or len(y_test) == 0:
+        sys.exit("fit_confidence.py: no BO rows with features in the --fit or --test files")
+    w = fit_logistic(x_fit, y_fit)
+    print(f"fitted on {len(y_fit)} runs ({int((1 - y_fit).sum())} failures)")
+    print(f"constexpr double kIntercept = {w[0]:.4g};")
+    for name, weight in zip(CONSTANTS, w[1:]):
+        print(f"constexpr double {name} = {weight:.4g};")
+
+    print(f"\ntested on {len(y_test)} other runs ({int((1 - y_test).sum())} failures)")
+    report(predict(w, x_test), y_test)
 
 
 if __name__ == "__main__":

@@ -44,7 +44,7 @@ void SeedOpen3d(uint64_t seed) { open3d::utility::random::Seed(static_cast<int>(
 
 MethodOutput Refined(const Transform& initial, const FeatureCloud& source,
                      const FeatureCloud& target, const MethodInput& input) {
-  const BoIcpConfig config = DatasetBoConfig("C", input);
+  const BoIcpConfig config = DatasetTableConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
   MethodOutput output;
   output.transform = RefineCoarseToFine({initial}, pair, config).transform;

@@ -8,7 +8,7 @@
 namespace boicp::bench {
 
 MethodOutput RunIcpFromIdentity(const MethodInput& input) {
-  const BoIcpConfig config = DatasetBoConfig("C", input);
+  const BoIcpConfig config = DatasetTableConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
   const Transform coarse = AlignPointToPoint(pair.search_source, pair.search_target,
                                              Transform::Identity(), SearchIcpOptions(config))

@@ -136,7 +136,7 @@ std::vector<Candidate> PyramidStage(const SearchSpace& space, GridScorer& scorer
 
 MethodOutput RunPyramid(const MethodInput& input) {
   const PyramidBudget budget = BudgetFor(input.quick);
-  const BoIcpConfig config = DatasetBoConfig("C", input);
+  const BoIcpConfig config = DatasetTableConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
   const Points score_points = RandomSubsample(pair.search_source, budget.score_points, input.seed);
   const double gate = config.EffectiveMaxCorrespondence();
