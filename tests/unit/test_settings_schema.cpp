@@ -73,6 +73,46 @@ TEST(SettingSchema, EveryMapAndSubmitFlagSurvivesRunJson) {
   }
 }
 
+TEST(SettingSchema, ConfigAsUsedNamesEveryRegistrationSettingAndReadsBack) {
+  const BoIcpConfig config = ConfigFromSettings(ParseFlags(kRegister, ExampleArguments(kRegister)));
+  const nlohmann::json used = ConfigToJson(config);
+  std::set<std::string> expected;
+  for (const SettingField& field : SettingSchema()) {
+    if ((field.frontends & kRegister) != 0) expected.insert(field.name);
+  }
+  expected.erase("fixed_settings");
+  std::set<std::string> keys;
+  for (const auto& item : used.items()) keys.insert(item.key());
+  EXPECT_EQ(keys, expected);
+  EXPECT_EQ(used["preset"], "B");
+  EXPECT_EQ(used["no_retry"], true);
+  EXPECT_EQ(used["rotation_bounds"], nlohmann::json({0.25, 0.5, 1.25}));
+
+  const BoIcpConfig read_back = ConfigFromJson(used, "test");
+  EXPECT_EQ(ConfigToJson(read_back), used);
+  EXPECT_TRUE(read_back.automatic.empty());
+  EXPECT_EQ(AllFields(SettingsFromConfig(read_back)), AllFields(SettingsFromConfig(config)));
+
+  nlohmann::json bad = used;
+  bad["voxel"] = "fine";
+  EXPECT_THROW(ConfigFromJson(bad, "test"), InputError);
+  bad["voxel"] = -1.0;
+  EXPECT_THROW(ConfigFromJson(bad, "test"), InputError);
+}
+
+TEST(SettingSchema, ConfigAsUsedReportsTheDerivedValues) {
+  BoIcpConfig config = PresetConfig("C");
+  config.voxel = 0.8;
+  config.max_correspondence_distance = 0.0;  // 0 = 3 x voxel
+  config.objective_truncation = 0.0;         // 0 = 1.5 x voxel
+  config.refine_voxel = 0.0;                 // 0 = voxel / 4
+  const nlohmann::json used = ConfigToJson(config);
+  EXPECT_DOUBLE_EQ(used["max_correspondence"].get<double>(), config.EffectiveMaxCorrespondence());
+  EXPECT_DOUBLE_EQ(used["objective_truncation"].get<double>(), config.EffectiveTruncation());
+  EXPECT_DOUBLE_EQ(used["refine_voxel"].get<double>(), config.EffectiveRefineVoxel());
+  EXPECT_DOUBLE_EQ(used["refine_voxel"].get<double>(), 0.2);
+}
+
 TEST(SettingSchema, MapAndSubmitSpellTheScanRangeApartFromTheRayCut) {
   const RequestedSettings map =
       ParseFlags(kMap, {"test", "--max-range", "30", "--scan-max-range", "80"});

@@ -9,6 +9,7 @@
 // that no front end and not the API takes.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <variant>
@@ -75,6 +76,17 @@ enum class ProtoMessage {
   kMapSettings,         // boicp.v1.MapSettings
 };
 
+/// The values a request to the daemon may give a number setting (each
+/// component of three-number settings), so that no batch makes it allocate
+/// or compute without limit. Only given values are checked ("0 = from the
+/// scans" stays allowed). The commands that run on the user's own machine
+/// do not apply them; whether a value makes sense at all (a positive voxel)
+/// is ValidateConfig's and ValidateOccupancySettings' to say.
+struct RequestLimits {
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+};
+
 struct SettingField {
   const char* name;      // identifier; for the registration fields the name
                          // BoIcpConfig::MarkSet and "auto" use
@@ -89,6 +101,7 @@ struct SettingField {
   /// register, the proto); nullptr when it is in all of them.
   const char* absent_because;
   SettingBinding binding;
+  RequestLimits limits;  // RequestLimits{} (unbounded) where no value costs the daemon much
 };
 
 /// Every setting, registration fields first, in the order help lists them.
