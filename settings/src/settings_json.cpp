@@ -103,11 +103,15 @@ void SettingsFromJson(const json& in, unsigned frontends, const std::string& sou
   FieldsFromJson(in, frontends, Shape::kGiven, source, settings);
 }
 
-json ConfigToJson(const BoIcpConfig& config) {
+json UsedSettingsToJson(const RequestedSettings& used) {
   // kRegister takes exactly the registration settings.
-  json out = FieldsToJson(SettingsFromConfig(config), kRegister, Shape::kUsed);
+  json out = FieldsToJson(used, kRegister, Shape::kUsed);
   out.erase("fixed_settings");
   return out;
+}
+
+json ConfigToJson(const BoIcpConfig& config) {
+  return UsedSettingsToJson(SettingsFromConfig(config));
 }
 
 BoIcpConfig ConfigFromJson(const json& in, const std::string& source) {

@@ -197,9 +197,8 @@ TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
     });
   }
   // One of them computed with another ICP gate: registered again.
-  EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) {
-    j["settings"]["config"]["max_correspondence_distance"] = 0.123;
-  });
+  EditPairFile(out / "pairs" / "000002-000003.json",
+               [](json& j) { j["settings"]["config"]["max_correspondence_distance"] = 0.123; });
   const RunResult again = Run(args);
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_EQ(json::parse(again.out)["pairs_reused"], 2);

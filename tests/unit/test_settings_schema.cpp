@@ -1,6 +1,7 @@
 // The settings schema: every field reaches BoIcpConfig from its flag, and
 // every field survives run.json.
 
+#include <cmath>
 #include <set>
 
 #include <gmock/gmock.h>
@@ -24,6 +25,12 @@ TEST(SettingSchema, NamesAreUniqueAndEveryApiGapIsExplained) {
     EXPECT_EQ(field.absent_because == nullptr, everywhere) << field.name;
     EXPECT_EQ(field.message == ProtoMessage::kNone, std::string(field.proto_field).empty())
         << field.name;
+    // Limits bound what a request gives a number.
+    const bool bounded = std::isfinite(field.limits.lower) || std::isfinite(field.limits.upper);
+    const bool number = std::visit(
+        [](const auto& binding) { return !kIsPlainBinding<std::decay_t<decltype(binding)>>; },
+        field.binding);
+    if (bounded) EXPECT_TRUE(number && field.message != ProtoMessage::kNone) << field.name;
     // Whatever the API takes, submit must be able to send.
     if (field.message != ProtoMessage::kNone) {
       EXPECT_TRUE(field.frontends & kSubmit) << field.name;

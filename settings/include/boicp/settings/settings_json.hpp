@@ -23,10 +23,15 @@ nlohmann::json SettingsToJson(const RequestedSettings& settings, unsigned fronte
 void SettingsFromJson(const nlohmann::json& json, unsigned frontends, const std::string& source,
                       RequestedSettings& settings);
 
-/// Every registration setting of `config` as used (SettingsFromConfig: the
-/// "0 = auto" values resolved), keyed by the setting's name (the names
-/// "auto" lists), bounds as three numbers. fixed_settings is left out: it
-/// says how values were chosen, it is not one of them.
+/// The registration settings as used (SettingsFromConfig's, or those a
+/// daemon reports for a job), keyed by the setting's name (the names "auto"
+/// lists), bounds as three numbers, null where `used` holds no value.
+/// fixed_settings is left out: it says how values were chosen, it is not
+/// one of them.
+nlohmann::json UsedSettingsToJson(const RequestedSettings& used);
+
+/// UsedSettingsToJson of `config`: every registration setting, the "0 =
+/// auto" values resolved (EffectiveRefineVoxel, ...).
 nlohmann::json ConfigToJson(const BoIcpConfig& config);
 
 /// The config ConfigToJson wrote: its preset with every value read applied
