@@ -30,7 +30,7 @@ TEST(SettingSchema, NamesAreUniqueAndEveryApiGapIsExplained) {
     const bool number = std::visit(
         [](const auto& binding) { return !kIsPlainBinding<std::decay_t<decltype(binding)>>; },
         field.binding);
-    if (bounded) EXPECT_TRUE(number && field.message != ProtoMessage::kNone) << field.name;
+    EXPECT_TRUE(!bounded || (number && field.message != ProtoMessage::kNone)) << field.name;
     // Whatever the API takes, submit must be able to send.
     if (field.message != ProtoMessage::kNone) {
       EXPECT_TRUE(field.frontends & kSubmit) << field.name;
