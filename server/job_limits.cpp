@@ -74,10 +74,12 @@ void RequireSettingsWithinLimits(const v1::SubmitBatchRequest& request) {
   }
 }
 
-// A ray visits range / resolution cells; a map of fine leaves needs a short ray.
+// A ray visits range / resolution cells; a map of fine leaves needs a short
+// ray. A ray of no limit (0) is taken to reach as far as a given one may.
 void RequireRaysWithinLimits(const v1::MapSettings& m, const JobLimits& limits) {
+  const double longest_ray = settings::FindSetting("max_range")->limits.upper;
   const double resolution = m.resolution() != 0.0 ? m.resolution() : OccupancySettings().resolution;
-  const double ray = m.max_range() != 0.0 ? m.max_range() : limits.unlimited_ray_m;
+  const double ray = m.max_range() != 0.0 ? m.max_range() : longest_ray;
   if (ray / resolution > limits.max_cells_per_ray) {
     std::ostringstream message;
     message << "map.max_range: rays of " << ray << " m"

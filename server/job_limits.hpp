@@ -13,7 +13,6 @@
 namespace boicp::server {
 
 struct JobLimits {
-  double unlimited_ray_m = 1000.0;     // what a map max_range of 0 (no limit) may reach
   double max_cells_per_ray = 20000.0;  // ray length over leaf size
   size_t max_label_bytes = 256;
   int max_listed_pairs = 100000;
