@@ -1,5 +1,7 @@
-// The settings schema: every field reaches BoIcpConfig from its flag, and
-// every field survives run.json.
+// The settings schema: every field reaches BoIcpConfig from its flag, every
+// field survives run.json, and a config as used (register --json, pair
+// files, run.json's chosen) names every registration setting, resolved, and
+// reads back.
 
 #include <cmath>
 #include <set>
@@ -117,6 +119,8 @@ TEST(SettingSchema, ConfigAsUsedReportsTheDerivedValues) {
   EXPECT_DOUBLE_EQ(used["max_correspondence"].get<double>(), config.EffectiveMaxCorrespondence());
   EXPECT_DOUBLE_EQ(used["objective_truncation"].get<double>(), config.EffectiveTruncation());
   EXPECT_DOUBLE_EQ(used["refine_voxel"].get<double>(), config.EffectiveRefineVoxel());
+  EXPECT_DOUBLE_EQ(used["max_correspondence"].get<double>(), 2.4);
+  EXPECT_DOUBLE_EQ(used["objective_truncation"].get<double>(), 1.2);
   EXPECT_DOUBLE_EQ(used["refine_voxel"].get<double>(), 0.2);
 }
 

@@ -1,12 +1,14 @@
 #pragma once
 // The one description of every registration and map setting: its name in
 // each front end (CLI flag, run.json key, boicp.v1 proto field), its help
-// text, and where its value lives. Flags, run.json, the proto conversions
-// and the bench are all generated from this table, so a setting added here
-// reaches every front end at once. BoIcpConfig fields missing from the table
-// (finish_icp_iterations, refine_max_iterations, refine_candidates,
-// refine_source_points, inlier_distance, retry_voxel, bo) are engine tuning
-// that no front end and not the API takes.
+// text, where its value lives and what a request to the daemon may give it.
+// Flags, run.json, the settings-as-used JSON (register --json, pair files),
+// the proto conversions, the daemon's request limits and the bench are all
+// generated from this table, so a setting added here reaches every front end
+// at once. BoIcpConfig fields missing from the table (finish_icp_iterations,
+// refine_max_iterations, refine_candidates, refine_source_points,
+// inlier_distance, retry_voxel, bo) are engine tuning that no front end and
+// not the API takes.
 
 #include <cstdint>
 #include <limits>
