@@ -4,6 +4,10 @@
 #
 #   bench/run.sh            standard suite into bench/results/ (< 30 min on 2 cores)
 #   bench/run.sh --quick    smoke test: 1 pair per dataset, reduced budgets (< 3 min)
+#   bench/run.sh --auto-settings
+#                           BO methods choose their settings from the clouds (no
+#                           dataset table), sources at any rotation (KITTI: any
+#                           yaw) -> bench/results-auto/
 #
 # Options: --out DIR, --bin PATH (default build/bin/boicp-bench, built if
 # missing), --data-root DIR (default ../shared/data), --threads T (default 2).
@@ -13,6 +17,7 @@ set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 QUICK=0
+AUTO=0
 OUT=""
 BIN=""
 DATA_ROOT="$ROOT/../shared/data"
@@ -23,18 +28,21 @@ METHODS="bo-A,bo-B,bo-C,bo-C-6dof,naive,icp-identity,pyramid,ransac-fpfh,fgr"
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) QUICK=1 ;;
+    --auto-settings) AUTO=1 ;;
     --out) OUT="$2"; shift ;;
     --bin) BIN="$2"; shift ;;
     --data-root) DATA_ROOT="$2"; shift ;;
     --threads) THREADS="$2"; shift ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "run.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
   shift
 done
 
 if [ -z "$OUT" ]; then
-  if [ "$QUICK" = 1 ]; then OUT="$(mktemp -d /tmp/boicp-bench-quick.XXXXXX)"; else OUT="$ROOT/bench/results"; fi
+  if [ "$QUICK" = 1 ]; then OUT="$(mktemp -d /tmp/boicp-bench-quick.XXXXXX)"
+  elif [ "$AUTO" = 1 ]; then OUT="$ROOT/bench/results-auto"
+  else OUT="$ROOT/bench/results"; fi
 fi
 
 PYTHON=/usr/bin/python3  # Debian's, with python3-matplotlib (deploy/install-deps.sh)
@@ -74,6 +82,7 @@ else
   fi
 fi
 [ "$QUICK" = 1 ] && ARGS+=(--quick)
+[ "$AUTO" = 1 ] && ARGS+=(--auto-settings)
 
 mkdir -p "$OUT"
 rm -f "$OUT"/results.csv "$OUT"/summary.md "$OUT"/*.png

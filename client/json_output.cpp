@@ -13,11 +13,13 @@ nlohmann::json TransformToJson(const Transform& T) {
 nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts) {
   nlohmann::json out = nlohmann::json::array();
   for (const Attempt& a : attempts) {
-    out.push_back({{"mode", SearchModeName(a.mode)},
+    out.push_back({{"kind", AttemptKindName(a.kind)},
+                   {"mode", SearchModeName(a.mode)},
                    {"seed", a.seed},
                    {"fitness", a.fitness},
                    {"confidence", a.confidence},
                    {"evaluations", a.evaluations},
+                   {"refined_ends", a.refined_ends},
                    {"runtime_s", a.runtime_s},
                    {"kept", a.kept}});
   }

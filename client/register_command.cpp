@@ -79,7 +79,7 @@ void PrintHuman(const RegistrationResult& r) {
             << "fitness     " << r.fitness << "\n"
             << "inlier_rmse " << r.inlier_rmse << " m\n"
             << "confidence  " << r.confidence << (r.doubtful ? " (doubtful)" : "") << "\n"
-            << "searches    " << r.attempts.size() << "\n"
+            << "attempts    " << r.attempts.size() << "\n"
             << "evaluations " << r.evaluations << "\n"
             << "runtime     " << r.runtime_s << " s\n";
 }

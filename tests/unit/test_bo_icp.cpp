@@ -121,8 +121,9 @@ TEST(BoIcp, SameSeedSameAnswerAndThreadCountDoesNotMatter) {
 }
 
 // Two unrelated blobs of noise: no answer fits, so the first search is
-// doubtful and a second one runs in 6 DOF with another seed.
-TEST(BoIcp, DoubtfulAnswerIsSearchedAgainInSixDof) {
+// doubtful. More of its ends are compared at the finest level, and when that
+// is still doubtful a second search runs in 6 DOF with another seed.
+TEST(BoIcp, DoubtfulAnswerIsTriedAgainWiderThenInSixDof) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-5.0, 5.0);
   Points source, target;
@@ -136,14 +137,33 @@ TEST(BoIcp, DoubtfulAnswerIsSearchedAgainInSixDof) {
   config.retry_when_doubtful = true;
   const RegistrationResult result = RegisterPair(source, target, config);
   EXPECT_TRUE(result.doubtful);
-  ASSERT_EQ(result.attempts.size(), 2u);
-  EXPECT_EQ(result.attempts[0].mode, SearchMode::kNested);
-  EXPECT_EQ(result.attempts[1].mode, SearchMode::kSixDof);
-  EXPECT_NE(result.attempts[0].seed, result.attempts[1].seed);
-  EXPECT_NE(result.attempts[0].kept, result.attempts[1].kept);
-  const Attempt& kept = result.attempts[0].kept ? result.attempts[0] : result.attempts[1];
-  EXPECT_EQ(kept.fitness, result.fitness);
-  EXPECT_GE(kept.fitness, std::min(result.attempts[0].fitness, result.attempts[1].fitness));
+  ASSERT_EQ(result.attempts.size(), 3u);
+  const Attempt& first = result.attempts[0];
+  const Attempt& wider = result.attempts[1];
+  const Attempt& second = result.attempts[2];
+  EXPECT_EQ(first.kind, AttemptKind::kSearch);
+  EXPECT_EQ(first.mode, SearchMode::kNested);
+  EXPECT_EQ(first.refined_ends, config.refine_candidates);
+  EXPECT_EQ(wider.kind, AttemptKind::kWiderRefinement);
+  EXPECT_EQ(wider.seed, first.seed);
+  EXPECT_EQ(wider.evaluations, 0);
+  EXPECT_GT(wider.refined_ends, first.refined_ends);
+  // The wider refinement compares the first one's ends too.
+  EXPECT_GE(wider.fitness, first.fitness);
+  EXPECT_EQ(second.kind, AttemptKind::kSearch);
+  EXPECT_EQ(second.mode, SearchMode::kSixDof);
+  EXPECT_NE(second.seed, first.seed);
+  int kept = 0;
+  double best_fitness = 0.0;
+  for (const Attempt& a : result.attempts) {
+    kept += a.kept ? 1 : 0;
+    best_fitness = std::max(best_fitness, a.fitness);
+    if (a.kept) {
+      EXPECT_EQ(a.fitness, result.fitness);
+    }
+  }
+  EXPECT_EQ(kept, 1);
+  EXPECT_EQ(result.fitness, best_fitness);
 
   config.retry_when_doubtful = false;
   EXPECT_EQ(RegisterPair(source, target, config).attempts.size(), 1u);

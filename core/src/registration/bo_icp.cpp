@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <utility>
 
@@ -162,17 +163,18 @@ bool SameBasin(const Transform& a, const Transform& b, double voxel) {
   return RotationAngle(delta) < 5.0 * M_PI / 180.0 && TranslationNorm(delta) < 3.0 * voxel;
 }
 
-// The best search results that ended in different basins, best first, at most `count`.
-std::vector<Evaluation> DistinctBest(std::vector<Evaluation> history, int count, double voxel) {
+// Where the search runs ended, one per basin, best search objective first,
+// at most `count`.
+std::vector<Transform> DistinctEnds(std::vector<Evaluation> history, int count, double voxel) {
   std::sort(history.begin(), history.end(),
             [](const Evaluation& a, const Evaluation& b) { return a.objective < b.objective; });
-  std::vector<Evaluation> picked;
+  std::vector<Transform> picked;
   for (const Evaluation& e : history) {
     if (static_cast<int>(picked.size()) >= count) break;
-    const bool repeats = std::any_of(picked.begin(), picked.end(), [&](const Evaluation& p) {
-      return SameBasin(p.result, e.result, voxel);
+    const bool repeats = std::any_of(picked.begin(), picked.end(), [&](const Transform& p) {
+      return SameBasin(p, e.result, voxel);
     });
-    if (!repeats) picked.push_back(e);
+    if (!repeats) picked.push_back(e.result);
   }
   return picked;
 }
@@ -191,6 +193,7 @@ double BasinSupport(const std::vector<Evaluation>& history, const Transform& ans
 
 // One search (nested or 6 DOF) and the refinement of its distinct best ends.
 struct SearchOutcome {
+  std::shared_ptr<const PreparedPair> prepared;  // kept for a wider refinement
   RefinedAlignment refined;
   double overlap = 0.0;  // RegistrationResult::overlap of the refined answer
   size_t source_points = 0, target_points = 0;
@@ -202,10 +205,31 @@ struct SearchOutcome {
   double confidence = 0.0;
 };
 
+// Refines the `count` best distinct ends of the outcome's search, compares
+// them at the finest level and assesses the winner.
+void RefineEnds(SearchOutcome& out, int count, const BoIcpConfig& config,
+                const RegistrationCallbacks& callbacks) {
+  if (callbacks.progress) callbacks.progress({"refine", 0, 1, out.objective});
+  out.refined =
+      RefineCoarseToFine(DistinctEnds(out.history, count, config.voxel), *out.prepared, config);
+  if (callbacks.progress) callbacks.progress({"refine", 1, 1, out.objective});
+  out.features.fitness = out.refined.score.fitness;
+  out.features.rmse_ratio = out.refined.score.inlier_rmse / config.EffectiveInlierDistance();
+  out.features.margin = out.refined.margin;
+  out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
+  out.features.probability_better = out.probability_better;
+  out.confidence = Confidence(out.features);
+  out.overlap = ScoreAlignment(out.prepared->search_source, out.prepared->search_target,
+                               out.refined.transform, 1.5 * config.voxel, config.threads)
+                    .fitness;
+}
+
 SearchOutcome SearchAndRefine(const Points& source, const Points& target, const BoIcpConfig& config,
                               const std::optional<Transform>& prior,
                               const RegistrationCallbacks& callbacks) {
-  const PreparedPair prepared = PreparePair(source, target, config);
+  const auto prepared_pair =
+      std::make_shared<const PreparedPair>(PreparePair(source, target, config));
+  const PreparedPair& prepared = *prepared_pair;
   Points evaluation_source = RandomSubsample(prepared.search_source, config.evaluation_points,
                                              config.seed ^ kSubsampleSalt);
   Points coarse_source =  // 0 points: all of them, so there is no separate first part
@@ -227,6 +251,7 @@ SearchOutcome SearchAndRefine(const Points& source, const Points& target, const 
 
   Search search(pair, config, callbacks);
   SearchOutcome out;
+  out.prepared = prepared_pair;
   BayesOptResult last;
   if (config.mode == SearchMode::kNested) {
     const BayesOptResult rotation = search.RunStage(
@@ -253,31 +278,23 @@ SearchOutcome SearchAndRefine(const Points& source, const Points& target, const 
   }
   out.objective = search.Best().objective;
 
-  // The search objective is measured on coarse voxels; a few distinct
-  // candidates are refined and compared at the finest level.
-  std::vector<Transform> candidates;
-  for (const Evaluation& e : DistinctBest(search.history(), config.refine_candidates, config.voxel))
-    candidates.push_back(e.result);
-  if (callbacks.progress) callbacks.progress({"refine", 0, 1, out.objective});
-  out.refined = RefineCoarseToFine(candidates, pair.prepared, config);
-  if (callbacks.progress) callbacks.progress({"refine", 1, 1, out.objective});
-
   out.gp_mean = last.gp_mean_at_best;
   out.gp_std = last.gp_std_at_best;
   out.history = std::move(search.history());
-  out.features.fitness = out.refined.score.fitness;
-  out.features.rmse_ratio = out.refined.score.inlier_rmse / config.EffectiveInlierDistance();
-  out.features.margin = out.refined.margin;
-  out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
-  out.features.probability_better = out.probability_better;
-  out.confidence = Confidence(out.features);
-  out.overlap = ScoreAlignment(search_source, prepared.search_target, out.refined.transform,
-                               1.5 * config.voxel, config.threads)
-                    .fitness;
   out.source_points = search_source.size();
   out.target_points = prepared.search_target.size();
+  // The search objective is measured on coarse voxels; a few distinct ends
+  // are refined and compared at the finest level.
+  RefineEnds(out, config.refine_candidates, config, callbacks);
   return out;
 }
+
+// A doubtful answer may be a basin that only looked best on coarse voxels
+// (a low-overlap view slid along a wall scores like the true one there),
+// while the true one, visited by the same search, ranked below the few
+// refined. The retry first compares this many of the search's distinct ends
+// at the finest level.
+constexpr int kWiderRefinementEnds = 8;
 
 // The seed of a retry: another stream of the same job seed.
 uint64_t RetrySeed(uint64_t seed) { return seed ^ 0xa0761d6478bd642fULL; }
@@ -301,6 +318,10 @@ BoIcpConfig RetryConfig(const BoIcpConfig& config) {
 
 }  // namespace
 
+std::string AttemptKindName(AttemptKind kind) {
+  return kind == AttemptKind::kSearch ? "search" : "wider-refinement";
+}
+
 RegistrationResult RegisterPair(const Points& source, const Points& target,
                                 const BoIcpConfig& requested, const std::optional<Transform>& prior,
                                 const RegistrationCallbacks& callbacks) {
@@ -314,25 +335,39 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   ValidateConfig(config);
 
   RegistrationResult result;
-  const auto attempt = [&](const BoIcpConfig& attempt_config) {
-    const auto attempt_started = std::chrono::steady_clock::now();
-    SearchOutcome outcome = SearchAndRefine(source, target, attempt_config, prior, callbacks);
+  const auto record = [&](AttemptKind kind, const BoIcpConfig& attempt_config,
+                          const SearchOutcome& outcome, int refined_ends,
+                          std::chrono::steady_clock::time_point attempt_started) {
     result.attempts.push_back(
-        {attempt_config.mode, attempt_config.seed, outcome.refined.score.fitness,
-         outcome.confidence, static_cast<int>(outcome.history.size()),
+        {kind, attempt_config.mode, attempt_config.seed, outcome.refined.score.fitness,
+         outcome.confidence,
+         kind == AttemptKind::kSearch ? static_cast<int>(outcome.history.size()) : 0, refined_ends,
          std::chrono::duration<double>(std::chrono::steady_clock::now() - attempt_started).count(),
          false});
+  };
+  const auto search = [&](const BoIcpConfig& attempt_config) {
+    const auto attempt_started = std::chrono::steady_clock::now();
+    SearchOutcome outcome = SearchAndRefine(source, target, attempt_config, prior, callbacks);
+    record(AttemptKind::kSearch, attempt_config, outcome, attempt_config.refine_candidates,
+           attempt_started);
     return outcome;
   };
-  SearchOutcome kept = attempt(config);
+  SearchOutcome kept = search(config);
   size_t kept_index = 0;
+  const auto keep_if_better = [&](SearchOutcome&& candidate) {
+    if (candidate.refined.score.fitness <= kept.refined.score.fitness) return;
+    kept = std::move(candidate);
+    kept_index = result.attempts.size() - 1;
+  };
   if (config.retry_when_doubtful && kept.confidence < kDoubtfulBelow) {
-    SearchOutcome second = attempt(RetryConfig(config));
-    if (second.refined.score.fitness > kept.refined.score.fitness) {
-      kept = std::move(second);
-      kept_index = 1;
-    }
+    const auto attempt_started = std::chrono::steady_clock::now();
+    SearchOutcome wider = kept;
+    RefineEnds(wider, kWiderRefinementEnds, config, callbacks);
+    record(AttemptKind::kWiderRefinement, config, wider, kWiderRefinementEnds, attempt_started);
+    keep_if_better(std::move(wider));
   }
+  if (config.retry_when_doubtful && kept.confidence < kDoubtfulBelow)
+    keep_if_better(search(RetryConfig(config)));
   result.attempts[kept_index].kept = true;
 
   result.transform = kept.refined.transform;

@@ -24,13 +24,25 @@ struct Evaluation {
   double objective = 0.0;                     // truncated mean distance after ICP, metres
 };
 
-/// One search of a registration: the first, and the retry of a doubtful one.
+/// What one attempt of a registration did.
+enum class AttemptKind {
+  kSearch,           ///< a BO search and the refinement of its best distinct ends
+  kWiderRefinement,  ///< more distinct ends of the first search refined and compared
+};
+
+/// "search" or "wider-refinement".
+std::string AttemptKindName(AttemptKind kind);
+
+/// One attempt of a registration: the first search, and for a doubtful answer
+/// a wider refinement of that search and then a second search.
 struct Attempt {
+  AttemptKind kind = AttemptKind::kSearch;
   SearchMode mode = SearchMode::kNested;
   uint64_t seed = 0;
   double fitness = 0.0;  // inlier fraction of its refined answer at the finest level
   double confidence = 0.0;
-  int evaluations = 0;
+  int evaluations = 0;   // ICP runs of its search (0 for a wider refinement)
+  int refined_ends = 0;  // distinct search ends compared at the finest level, at most
   double runtime_s = 0.0;
   bool kept = false;  // its answer is the result's
 };

@@ -102,11 +102,13 @@ struct BoIcpConfig {
   BayesOptOptions bo = RegistrationBayesOptOptions();
 
   // --- Checking the answer ---------------------------------------------------
-  // A doubtful first answer (confidence < kDoubtfulBelow) starts one more
-  // search: in 6 DOF (a nested search commits to one rotation before it
-  // looks at translations), with another seed, at retry_voxel. The extra
-  // budget is one search of the same N_r and N. The better fit at the same
-  // finest level is kept.
+  // A doubtful first answer (confidence < kDoubtfulBelow) is tried again:
+  // first the search's 8 best distinct ends (instead of refine_candidates)
+  // are compared at the finest level; if the answer is still doubtful, one
+  // more search runs in 6 DOF (a nested search commits to one rotation
+  // before it looks at translations), with another seed, at retry_voxel.
+  // The extra budget is those refinements and one search of the same N_r
+  // and N. The better fit at the same finest level is kept.
   bool retry_when_doubtful = true;
   // Search voxel of the retry, metres; 0 = voxel. Automatic settings make it
   // coarser than the first search's: a smoother objective with wider basins,
