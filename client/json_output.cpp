@@ -1,38 +1,13 @@
 #include "json_output.hpp"
 
+#include "boicp/settings/settings_json.hpp"
+
 namespace boicp::cli {
 
 nlohmann::json TransformToJson(const Transform& T) {
   nlohmann::json rows = nlohmann::json::array();
   for (int i = 0; i < 4; ++i) rows.push_back({T(i, 0), T(i, 1), T(i, 2), T(i, 3)});
   return rows;
-}
-
-nlohmann::json ConfigToJson(const BoIcpConfig& c) {
-  auto triple = [](const Eigen::Vector3d& v) { return nlohmann::json{v[0], v[1], v[2]}; };
-  return {{"preset", c.preset},
-          {"mode", SearchModeName(c.mode)},
-          {"random_samples", c.random_samples},
-          {"iterations", c.iterations},
-          {"voxel", c.voxel},
-          {"rotation_bounds", triple(c.rotation_bounds)},
-          {"translation_bounds", triple(c.translation_bounds)},
-          {"max_correspondence_distance", c.EffectiveMaxCorrespondence()},
-          {"objective_truncation", c.EffectiveTruncation()},
-          {"icp_max_iterations", c.icp_max_iterations},
-          {"evaluation_points", c.evaluation_points},
-          {"coarse_icp_points", c.coarse_icp_points},
-          {"finish_icp_iterations", c.finish_icp_iterations},
-          {"refine_voxel", c.EffectiveRefineVoxel()},
-          {"refine_max_iterations", c.refine_max_iterations},
-          {"refine_candidates", c.refine_candidates},
-          {"refine_source_points", c.refine_source_points},
-          {"inlier_distance", c.EffectiveInlierDistance()},
-          {"min_range", c.min_range},
-          {"max_range", c.max_range},
-          {"retry_when_doubtful", c.retry_when_doubtful},
-          {"seed", c.seed},
-          {"threads", c.threads}};
 }
 
 nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts) {
@@ -68,7 +43,7 @@ nlohmann::json RegistrationToJson(const RegistrationResult& r,
           {"probability_better", r.probability_better},
           {"source_points", r.source_points},
           {"target_points", r.target_points},
-          {"config", ConfigToJson(r.config)},
+          {"config", settings::ConfigToJson(r.config)},
           {"auto", auto_fields}};
 }
 

@@ -10,16 +10,15 @@ namespace boicp::cli {
 /// 4x4 row-major nested array.
 nlohmann::json TransformToJson(const Transform& T);
 
-nlohmann::json ConfigToJson(const BoIcpConfig& config);
-
 /// One object per search made: mode, seed, fitness, confidence, evaluations,
 /// runtime_s, kept.
 nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts);
 
 /// {"transform", "objective", "fitness", "inlier_rmse", "overlap",
 ///  "confidence", "doubtful", "attempts", "evaluations", "runtime_s",
-///  "config" (the settings used), "auto" (`auto_fields`: the settings chosen
-///  from the clouds), plus GP and point-count details}.
+///  "config" (the settings used: settings::ConfigToJson), "auto"
+///  (`auto_fields`: the settings chosen from the clouds), plus GP and
+///  point-count details}.
 nlohmann::json RegistrationToJson(const RegistrationResult& result,
                                   const std::vector<std::string>& auto_fields);
 

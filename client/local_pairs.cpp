@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "boicp/settings/settings_json.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "json_output.hpp"
 
@@ -35,13 +36,36 @@ Transform TransformFromJson(const json& rows) {
   return T;
 }
 
+// The config object of a pair's settings: the registration settings as used,
+// without the thread count, which no result depends on.
+json PairConfigJson(const BoIcpConfig& config) {
+  json out = settings::ConfigToJson(config);
+  out.erase("threads");
+  return out;
+}
+
+// Pair files written before the config object followed the schema named a
+// few settings otherwise and listed engine constants no front end sets. Such
+// a config is read under the old names and written as PairSettings writes it
+// now, so that those pairs are reused rather than registered again.
+void UpgradeOldPairConfig(json& config, const std::string& source) {
+  if (!config.contains("retry_when_doubtful")) return;
+  static const std::pair<const char*, const char*> kRenamed[] = {
+      {"max_correspondence_distance", "max_correspondence"},
+      {"icp_max_iterations", "icp_iterations"},
+      {"max_range", "scan_max_range"}};
+  for (const auto& [old_key, key] : kRenamed) {
+    if (config.contains(old_key)) config[key] = config.at(old_key);
+  }
+  config["no_retry"] = !config.at("retry_when_doubtful").get<bool>();
+  config = PairConfigJson(settings::ConfigFromJson(config, source));
+}
+
 }  // namespace
 
 json PairSettings(const std::vector<ScanSource>& scans, const PairIndex& pair,
                   const BoIcpConfig& config) {
-  json config_json = ConfigToJson(config);
-  config_json.erase("threads");  // results do not depend on it
-  return {{"config", config_json},
+  return {{"config", PairConfigJson(config)},
           {"source", ScanSettings(scans.at(static_cast<size_t>(pair.source)))},
           {"target", ScanSettings(scans.at(static_cast<size_t>(pair.target)))}};
 }
@@ -147,6 +171,7 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
       }
     }
     r.settings = j.at("settings");
+    UpgradeOldPairConfig(r.settings.at("config"), path);
     return r;
   } catch (const std::exception& e) {
     throw InputError(path + ": not a pair result file (" + e.what() + ")");

@@ -8,7 +8,6 @@
 #include "boicp/settings/setting_schema.hpp"
 #include "boicp/settings/settings_json.hpp"
 #include "cli_parsing.hpp"
-#include "json_output.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -167,7 +166,7 @@ void PrintRunSettings(const LocalRun& run) {
 
 json RunManifestJson(const LocalRun& run) {
   json manifest = MapSettingsToJson(run.settings);
-  manifest["chosen"] = ConfigToJson(run.config);
+  manifest["chosen"] = settings::ConfigToJson(run.config);
   manifest["chosen"]["map_resolution"] = run.map.occupancy.resolution;
   manifest["chosen"]["map_max_range"] = run.map.occupancy.max_range;
   manifest["auto"] = run.auto_fields;

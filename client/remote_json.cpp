@@ -2,26 +2,21 @@
 
 #include <cstdio>
 
+#include "boicp/rpc/settings_proto.hpp"
+#include "boicp/settings/settings_json.hpp"
 #include "json_output.hpp"
 
 namespace boicp::cli {
 
 nlohmann::json ChosenSettingsToJson(const v1::ChosenSettings& s) {
-  const v1::RegistrationConfig& c = s.config();
-  const auto triple = [](const v1::Vector3& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
-  return {{"preset", c.preset()},
-          {"mode", c.mode()},
-          {"voxel", c.voxel()},
-          {"refine_voxel", c.refine_voxel()},
-          {"rotation_bounds", triple(c.rotation_bounds())},
-          {"translation_bounds", triple(c.translation_bounds())},
-          {"random_samples", c.random_samples()},
-          {"iterations", c.iterations()},
-          {"retry_when_doubtful", !c.no_retry()},
-          {"seed", c.seed()},
-          {"map_resolution", s.map_resolution()},
-          {"map_max_range", s.map_max_range()},
-          {"auto", s.auto_fields()}};
+  nlohmann::json out =
+      settings::UsedSettingsToJson(rpc::SettingsFromProto(s.config(), v1::MapSettings()));
+  // Settings the API does not carry have no value here: left out.
+  for (auto it = out.begin(); it != out.end();) it = it->is_null() ? out.erase(it) : ++it;
+  out["map_resolution"] = s.map_resolution();
+  out["map_max_range"] = s.map_max_range();
+  out["auto"] = s.auto_fields();
+  return out;
 }
 
 std::string DescribeChosenSettings(const v1::ChosenSettings& s) {

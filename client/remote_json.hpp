@@ -15,8 +15,10 @@ namespace boicp::cli {
 ///  "num_scans", "stage_done", "stage_total", "eta_seconds", "created_at",
 ///  "started_at", "finished_at", "error", "cancel_requested",
 ///  "pose_graph_optimised"}; times are Unix seconds (0 = not yet).
-/// A job's chosen settings: the config fields, map_resolution, map_max_range
-/// and "auto" (the names of the fields chosen from the scans).
+/// A job's chosen settings: the registration settings the API carries, as
+/// settings::UsedSettingsToJson writes them (the keys of run.json's
+/// "chosen"), map_resolution, map_max_range and "auto" (the names of the
+/// fields chosen from the scans).
 nlohmann::json ChosenSettingsToJson(const v1::ChosenSettings& settings);
 
 /// The same on one line, for `boicp show`.

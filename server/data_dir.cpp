@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "boicp/rpc/sha256.hpp"
 #include "boicp/util/types.hpp"
-#include "rpc_names.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {
@@ -94,12 +94,12 @@ DataDir::~DataDir() {
 std::string DataDir::DatabasePath() const { return (fs::path(root_) / "boicpd.sqlite").string(); }
 
 std::string DataDir::ScanPath(const std::string& scan_id) const {
-  if (!IsSha256Hex(scan_id)) throw InputError("'" + scan_id + "' is not a scan id");
+  if (!rpc::IsSha256Hex(scan_id)) throw InputError("'" + scan_id + "' is not a scan id");
   return (fs::path(root_) / "scans" / scan_id.substr(0, 2) / scan_id).string();
 }
 
 bool DataDir::HasScanFile(const std::string& scan_id) const {
-  if (!IsSha256Hex(scan_id)) return false;
+  if (!rpc::IsSha256Hex(scan_id)) return false;
   std::error_code ec;
   return fs::is_regular_file(ScanPath(scan_id), ec);
 }

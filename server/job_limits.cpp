@@ -3,13 +3,19 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <type_traits>
 
+#include "boicp/mapping/occupancy_map.hpp"
+#include "boicp/rpc/settings_proto.hpp"
+#include "boicp/settings/setting_schema.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp::server {
 namespace {
 
 namespace v1 = ::boicp::v1;
+using settings::RequestLimits;
+using settings::SettingField;
 
 template <typename Value, typename Limit>
 void RequireAtMost(const std::string& field, Value value, Limit limit) {
@@ -29,39 +35,51 @@ void RequireAtLeast(const std::string& field, Value value, Limit limit) {
   }
 }
 
-void RequireHalfWidthsAtMost(const std::string& field, const v1::Vector3& v, double limit) {
-  RequireAtMost(field + ".x", v.x(), limit);
-  RequireAtMost(field + ".y", v.y(), limit);
-  RequireAtMost(field + ".z", v.z(), limit);
+// A count's limit is shown as a count ("1000000", not "1e+06").
+template <typename T>
+auto LimitAs(double limit) {
+  if constexpr (std::is_integral_v<T>) {
+    return static_cast<T>(limit);
+  } else {
+    return limit;
+  }
 }
 
-void RequireSearchWithinLimits(const v1::RegistrationConfig& c, const JobLimits& limits) {
-  if (c.has_random_samples()) {
-    RequireAtMost("config.random_samples", c.random_samples(), limits.max_random_samples);
-  }
-  if (c.has_iterations()) RequireAtMost("config.iterations", c.iterations(), limits.max_iterations);
-  if (c.has_evaluation_points()) {
-    RequireAtMost("config.evaluation_points", c.evaluation_points(), limits.max_evaluation_points);
-  }
-  if (c.has_rotation_bounds()) {
-    RequireHalfWidthsAtMost("config.rotation_bounds", c.rotation_bounds(), M_PI);
-  }
-  if (c.has_translation_bounds()) {
-    RequireHalfWidthsAtMost("config.translation_bounds", c.translation_bounds(),
-                            limits.max_translation_bounds_m);
-  }
-  if (c.has_min_range()) RequireAtMost("config.min_range", c.min_range(), limits.max_range_m);
-  if (c.has_max_range()) RequireAtMost("config.max_range", c.max_range(), limits.max_range_m);
+template <typename T>
+void RequireWithin(const std::string& field, T value, const RequestLimits& limits) {
+  if (std::isfinite(limits.lower)) RequireAtLeast(field, value, LimitAs<T>(limits.lower));
+  if (std::isfinite(limits.upper)) RequireAtMost(field, value, LimitAs<T>(limits.upper));
 }
 
-// A ray visits range / resolution cells; a map of fine leaves needs a short ray.
-void RequireMapWithinLimits(const v1::MapSettings& m, const JobLimits& limits) {
-  if (m.resolution() != 0.0) {
-    RequireAtLeast("map.resolution", m.resolution(), limits.min_map_resolution_m);
+void RequireWithin(const std::string& field, const Eigen::Vector3d& value,
+                   const RequestLimits& limits) {
+  RequireWithin(field + ".x", value.x(), limits);
+  RequireWithin(field + ".y", value.y(), limits);
+  RequireWithin(field + ".z", value.z(), limits);
+}
+
+// Every given setting within the schema's limits for it.
+void RequireSettingsWithinLimits(const v1::SubmitBatchRequest& request) {
+  const settings::RequestedSettings given = rpc::SettingsFromProto(request.config(), request.map());
+  for (const SettingField& field : settings::SettingSchema()) {
+    if (field.message == settings::ProtoMessage::kNone) continue;
+    std::visit(
+        [&](const auto& binding) {
+          if constexpr (!settings::kIsPlainBinding<std::decay_t<decltype(binding)>>) {
+            const auto& value = given.*binding.requested;
+            if (value) RequireWithin(rpc::ProtoFieldPath(field), *value, field.limits);
+          }
+        },
+        field.binding);
   }
-  RequireAtMost("map.max_range", m.max_range(), limits.max_range_m);
-  const double resolution = m.resolution() != 0.0 ? m.resolution() : 0.2;
-  const double ray = m.max_range() != 0.0 ? m.max_range() : limits.unlimited_ray_m;
+}
+
+// A ray visits range / resolution cells; a map of fine leaves needs a short
+// ray. A ray of no limit (0) is taken to reach as far as a given one may.
+void RequireRaysWithinLimits(const v1::MapSettings& m, const JobLimits& limits) {
+  const double longest_ray = settings::FindSetting("max_range")->limits.upper;
+  const double resolution = m.resolution() != 0.0 ? m.resolution() : OccupancySettings().resolution;
+  const double ray = m.max_range() != 0.0 ? m.max_range() : longest_ray;
   if (ray / resolution > limits.max_cells_per_ray) {
     std::ostringstream message;
     message << "map.max_range: rays of " << ray << " m"
@@ -70,16 +88,13 @@ void RequireMapWithinLimits(const v1::MapSettings& m, const JobLimits& limits) {
             << limits.max_cells_per_ray << "; shorten map.max_range or coarsen map.resolution";
     throw InputError(message.str());
   }
-  if (m.cloud_voxel() != 0.0) {
-    RequireAtLeast("map.cloud_voxel", m.cloud_voxel(), limits.min_cloud_voxel_m);
-  }
 }
 
 }  // namespace
 
 void RequireWithinJobLimits(const v1::SubmitBatchRequest& request, const JobLimits& limits) {
-  RequireSearchWithinLimits(request.config(), limits);
-  RequireMapWithinLimits(request.map(), limits);
+  RequireSettingsWithinLimits(request);
+  RequireRaysWithinLimits(request.map(), limits);
   RequireAtMost("pairing.pairs", request.pairing().pairs_size(), limits.max_listed_pairs);
   if (request.label().size() > limits.max_label_bytes) {
     throw InputError("label: " + std::to_string(request.label().size()) +

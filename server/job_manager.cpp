@@ -5,9 +5,9 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "job_spec.hpp"
 #include "log_text.hpp"
-#include "rpc_names.hpp"
 #include "service_error.hpp"
 #include "storage_check.hpp"
 
@@ -40,7 +40,7 @@ void JobManager::Start() {
       // Cancelled while a previous daemon ran it: finish the cancellation.
       job.set_state(v1::JOB_STATE_CANCELLED);
       job.set_stage("cancelled");
-      job.set_finished_at(NowSeconds());
+      job.set_finished_at(rpc::NowSeconds());
       store_.UpdateJob(job);
       Publish(job);
       spdlog::info("job {} cancelled (requested before the restart)", job.job_id());
@@ -53,7 +53,7 @@ void JobManager::Start() {
       job.set_error(
           "boicpd stopped unexpectedly (killed, perhaps for memory) in each of its last " +
           std::to_string(kMaxUnendedRuns) + " runs of this job; it is not resumed again");
-      job.set_finished_at(NowSeconds());
+      job.set_finished_at(rpc::NowSeconds());
       job.set_eta_seconds(-1.0);
       store_.UpdateJob(job);
       Publish(job);
@@ -120,7 +120,7 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
                              : spec.base_pairs.size() + spec.extra_pairs.size();
   job.set_pairs_total(static_cast<uint32_t>(planned));
   job.set_eta_seconds(-1.0);
-  job.set_created_at(NowSeconds());
+  job.set_created_at(rpc::NowSeconds());
   job = store_.CreateJob(job, input);
   queue_.push_back(job.job_id());
   queue_changed_.notify_one();
@@ -139,7 +139,7 @@ v1::Job JobManager::Cancel(const std::string& job_id) {
     job->set_state(v1::JOB_STATE_CANCELLED);
     job->set_stage("cancelled");
     job->set_cancel_requested(true);
-    job->set_finished_at(NowSeconds());
+    job->set_finished_at(rpc::NowSeconds());
     job->set_eta_seconds(-1.0);
     store_.UpdateJob(*job);
     Publish(*job);

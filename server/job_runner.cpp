@@ -9,10 +9,10 @@
 
 #include "boicp/mapping/batch_pair.hpp"
 #include "boicp/mapping/map_pipeline.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 #include "job_outputs.hpp"
 #include "job_pair_store.hpp"
 #include "job_spec.hpp"
-#include "rpc_names.hpp"
 #include "scan_integrity.hpp"
 
 namespace boicp::server {
@@ -109,7 +109,7 @@ class JobRun : public MapProgressSink {
     batch_.map.fusion_threads = ctx_.pool.size();
     batch_.plan = JobPlan(batch_spec_);
     job_.set_state(v1::JOB_STATE_RUNNING);
-    if (job_.started_at() == 0.0) job_.set_started_at(NowSeconds());
+    if (job_.started_at() == 0.0) job_.set_started_at(rpc::NowSeconds());
     job_.set_stage("registering");
     job_.set_eta_seconds(-1.0);
   }
@@ -242,7 +242,7 @@ class JobRun : public MapProgressSink {
       v1::TrajectoryPose pose;
       pose.set_index(static_cast<uint32_t>(i));
       pose.set_scan_id(batch_spec_.scan_ids[i]);
-      TransformToProto(map.estimate.poses[i], pose.mutable_pose());
+      rpc::TransformToProto(map.estimate.poses[i], pose.mutable_pose());
       pose.set_timestamp(stamps[i]);
       trajectory.push_back(std::move(pose));
     }
@@ -259,9 +259,9 @@ class JobRun : public MapProgressSink {
 
   RunOutcome End(v1::JobState state, const std::string& error) {
     job_.set_state(state);
-    job_.set_stage(state == v1::JOB_STATE_SUCCEEDED ? "done" : JobStateName(state));
+    job_.set_stage(state == v1::JOB_STATE_SUCCEEDED ? "done" : rpc::JobStateName(state));
     job_.set_error(error);
-    job_.set_finished_at(NowSeconds());
+    job_.set_finished_at(rpc::NowSeconds());
     job_.set_eta_seconds(state == v1::JOB_STATE_SUCCEEDED ? 0.0 : -1.0);
     job_.set_cancel_requested(control_.cancelled());
     // Watchers learn a final state only once it is stored: one that was not
@@ -270,7 +270,7 @@ class JobRun : public MapProgressSink {
       Persist();
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot record the final state {}: {}", job_.job_id(),
-                    JobStateName(state), e.what());
+                    rpc::JobStateName(state), e.what());
       return RunOutcome::kFailed;
     }
     Publish(nullptr);
@@ -280,7 +280,7 @@ class JobRun : public MapProgressSink {
       return RunOutcome::kFailed;
     }
     spdlog::info("job {} {} after {:.1f} s ({} of {} pairs; {})", job_.job_id(),
-                 JobStateName(state), took, job_.pairs_done(), job_.pairs_total(),
+                 rpc::JobStateName(state), took, job_.pairs_done(), job_.pairs_total(),
                  DoubtfulSummary(static_cast<int>(job_.pairs_doubtful()),
                                  static_cast<int>(job_.pairs_done())));
     return state == v1::JOB_STATE_SUCCEEDED ? RunOutcome::kSucceeded : RunOutcome::kCancelled;

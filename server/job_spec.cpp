@@ -4,10 +4,10 @@
 #include <limits>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 #include "boicp/rpc/settings_proto.hpp"
 #include "boicp/settings/requested_settings.hpp"
 #include "job_limits.hpp"
-#include "rpc_names.hpp"
 
 namespace boicp::server {
 namespace {
@@ -55,14 +55,14 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
     const std::string field = "scan_ids[" + std::to_string(i) + "]";
     ScanSource source;
     source.path = data_dir.ScanPath(request.scan_ids(i));
-    source.load = LoadOptionsFromMetadata(meta);
+    source.load = rpc::LoadOptionsFromMetadata(meta);
     // Stored scans met the point limit at upload; the job checks it at submission.
     source.load.max_points = std::numeric_limits<uint64_t>::max();
     if (meta.has_sensor_origin()) {
-      source.sensor_origin = PointFromProto(meta.sensor_origin(), field + ".sensor_origin");
+      source.sensor_origin = rpc::PointFromProto(meta.sensor_origin(), field + ".sensor_origin");
     }
     if (meta.has_prior_pose()) {
-      source.prior_pose = TransformFromProto(meta.prior_pose(), field + ".prior_pose");
+      source.prior_pose = rpc::TransformFromProto(meta.prior_pose(), field + ".prior_pose");
     }
     if (meta.has_timestamp()) source.timestamp = meta.timestamp();
     spec.scan_ids.push_back(request.scan_ids(i));

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <set>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "boicp/util/types.hpp"
-#include "rpc_names.hpp"
 
 namespace boicp::server {
 namespace {
@@ -179,7 +179,7 @@ bool JobStore::UpdateJob(const v1::Job& job) {
   std::lock_guard<std::mutex> lock(mutex_);
   SqliteDatabase::Transaction transaction(db_);
   const std::optional<v1::Job> stored = ReadJob(job.job_id());
-  if (!stored || IsTerminal(stored->state())) return false;
+  if (!stored || rpc::IsTerminal(stored->state())) return false;
   v1::Job merged = job;
   if (stored->cancel_requested()) merged.set_cancel_requested(true);
   WriteJob(merged);
@@ -191,7 +191,7 @@ std::optional<v1::Job> JobStore::RequestCancel(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
   SqliteDatabase::Transaction transaction(db_);
   std::optional<v1::Job> job = ReadJob(job_id);
-  if (!job || IsTerminal(job->state()) || job->cancel_requested()) return job;
+  if (!job || rpc::IsTerminal(job->state()) || job->cancel_requested()) return job;
   job->set_cancel_requested(true);
   WriteJob(*job);
   transaction.Commit();

@@ -1,6 +1,6 @@
 #include "pair_result_proto.hpp"
 
-#include "rpc_names.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 
 namespace boicp::server {
 
@@ -12,7 +12,7 @@ namespace boicp::server {
   out.set_target(static_cast<uint32_t>(pair.target));
   out.set_source_scan_id(spec.scan_ids.at(static_cast<size_t>(pair.source)));
   out.set_target_scan_id(spec.scan_ids.at(static_cast<size_t>(pair.target)));
-  TransformToProto(r.transform, out.mutable_transform());
+  rpc::TransformToProto(r.transform, out.mutable_transform());
   out.set_objective(r.objective);
   out.set_fitness(r.fitness);
   out.set_inlier_rmse(r.inlier_rmse);
@@ -21,7 +21,7 @@ namespace boicp::server {
   out.set_overlap(r.overlap);
   out.set_evaluations(static_cast<uint32_t>(r.evaluations));
   out.set_runtime_s(r.runtime_s);
-  out.set_finished_at(NowSeconds());
+  out.set_finished_at(rpc::NowSeconds());
   out.set_seed(batch.seed);
   out.set_in_graph(true);
   return out;
@@ -31,7 +31,7 @@ FinishedPair FinishedFromProto(const ::boicp::v1::PairResult& result,
                                const InformationMatrix& information) {
   FinishedPair finished;
   finished.pair = {static_cast<int>(result.source()), static_cast<int>(result.target())};
-  finished.transform = TransformFromProto(result.transform(), "stored pair");
+  finished.transform = rpc::TransformFromProto(result.transform(), "stored pair");
   finished.information = information;
   finished.confidence = result.has_doubtful() ? result.confidence() : 1.0;
   finished.planner_overlap = result.has_overlap() ? result.overlap() : result.fitness();

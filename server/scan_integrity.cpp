@@ -11,7 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "rpc_names.hpp"
+#include "boicp/rpc/sha256.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {
@@ -46,7 +46,7 @@ void VerifyStoredScan(const DataDir& dir, const std::string& scan_id) {
     throw StorageError("scan " + scan_id + ": cannot open " + path + " (" + std::strerror(error) +
                        ")");
   }
-  Sha256 hash;
+  rpc::Sha256 hash;
   std::vector<char> buffer(kReadBytes);
   for (;;) {
     const ssize_t got = ::read(file.fd, buffer.data(), buffer.size());

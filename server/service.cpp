@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "export_reactor.hpp"
 #include "job_outputs.hpp"
-#include "rpc_names.hpp"
 #include "service_error.hpp"
 #include "upload_reactor.hpp"
 
@@ -161,7 +161,7 @@ grpc::ServerWriteReactor<v1::ExportChunk>* MapBuilderService::Export(
         throw InputError("format: unknown export format " + std::to_string(request->format()));
       if (job.state() != v1::JOB_STATE_SUCCEEDED) {
         throw ServiceError(grpc::StatusCode::FAILED_PRECONDITION,
-                           "job '" + job.job_id() + "' is " + JobStateName(job.state()) +
+                           "job '" + job.job_id() + "' is " + rpc::JobStateName(job.state()) +
                                "; its outputs exist once it has succeeded");
       }
       name = *file;

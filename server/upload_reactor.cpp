@@ -7,7 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "rpc_names.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 #include "scan_integrity.hpp"
 #include "service.hpp"
 #include "service_error.hpp"
@@ -38,7 +38,7 @@ void RequirePointLimit(uint64_t points, uint64_t limit) {
 // allocate its points.
 LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& metadata,
                              uint64_t max_points) {
-  LoadOptions options = LoadOptionsFromMetadata(metadata);
+  LoadOptions options = rpc::LoadOptionsFromMetadata(metadata);
   options.max_points = max_points;
   try {
     return LoadPointCloud(path, options);
@@ -126,7 +126,7 @@ void UploadReactor::Accept(const v1::UploadScanRequest& request) {
 
 void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
   if (metadata_) throw InputError("metadata may only be sent once, first");
-  ValidateScanMetadata(metadata);
+  rpc::ValidateScanMetadata(metadata);
   known_ = ReuseStoredCopy(metadata);
   if (!known_) {
     if (metadata.size_bytes() == 0) {

@@ -13,8 +13,8 @@
 
 #include <grpcpp/support/server_callback.h>
 
+#include "boicp/rpc/sha256.hpp"
 #include "boicp/v1/map_builder.pb.h"
-#include "rpc_names.hpp"
 #include "upload_budget.hpp"
 
 namespace boicp::server {
@@ -58,7 +58,7 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   std::string corruption_;  // the stored copy of the named hash failed its check
   std::string temp_path_;
   std::ofstream temp_;
-  Sha256 hash_;
+  rpc::Sha256 hash_;
   uint64_t received_ = 0;
   uint64_t idle_id_ = 0;  // in deps_.idle_uploads; 0 = not timed
 };

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "rpc_names.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 #include "watch_queue.hpp"
 
 namespace boicp::server {
@@ -80,7 +80,7 @@ void WatchHub::Publish(const v1::JobEvent& event) {
   std::lock_guard<std::mutex> lock(mutex_);
   // A final state is published only once stored, so the store answers for
   // finished jobs and the cache holds only the ones still running.
-  if (IsTerminal(event.job().state())) {
+  if (rpc::IsTerminal(event.job().state())) {
     latest_.erase(event.job().job_id());
   } else {
     latest_[event.job().job_id()] = event.job();
@@ -163,7 +163,7 @@ void WatchHub::Pump() {
       } else if (!s->pending.empty()) {
         s->current = s->pending.Pop();
         s->writing = true;
-        if (IsTerminal(s->current.job().state())) s->RequestFinish(grpc::Status::OK);
+        if (rpc::IsTerminal(s->current.job().state())) s->RequestFinish(grpc::Status::OK);
         actions.push_back({s, false, {}});
       }
     }

@@ -109,15 +109,11 @@ T GetValue(const pb::Message& message, const pb::FieldDescriptor* field, const s
   }
 }
 
-const char* PrefixOf(ProtoMessage message) {
-  return message == ProtoMessage::kRegistrationConfig ? "config." : "map.";
-}
-
 void WriteFields(ProtoMessage which, const RequestedSettings& settings, pb::Message* root) {
   for (const SettingField& field : settings::SettingSchema()) {
     if (field.message != which) continue;
     const auto [message, descriptor] = Resolve(root, field.proto_field);
-    const std::string name = PrefixOf(which) + std::string(field.proto_field);
+    const std::string name = ProtoFieldPath(field);
     std::visit(
         [&, message = message, descriptor = descriptor](const auto& binding) {
           const auto& value = settings.*binding.requested;
@@ -135,7 +131,7 @@ void ReadFields(ProtoMessage which, const pb::Message& root, RequestedSettings& 
   for (const SettingField& field : settings::SettingSchema()) {
     if (field.message != which) continue;
     const auto [message, descriptor] = Resolve(&root, field.proto_field);
-    const std::string name = PrefixOf(which) + std::string(field.proto_field);
+    const std::string name = ProtoFieldPath(field);
     std::visit(
         [&, message = message, descriptor = descriptor](const auto& binding) {
           using T = typename settings::BindingValue<std::decay_t<decltype(binding)>>::type;
@@ -147,6 +143,11 @@ void ReadFields(ProtoMessage which, const pb::Message& root, RequestedSettings& 
 }
 
 }  // namespace
+
+std::string ProtoFieldPath(const SettingField& field) {
+  const char* prefix = field.message == ProtoMessage::kRegistrationConfig ? "config." : "map.";
+  return prefix + std::string(field.proto_field);
+}
 
 v1::RegistrationConfig RegistrationConfigToProto(const RequestedSettings& settings) {
   v1::RegistrationConfig proto;

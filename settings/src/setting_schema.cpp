@@ -1,10 +1,14 @@
 #include "boicp/settings/setting_schema.hpp"
 
+#include <cmath>
+
 namespace boicp::settings {
 namespace {
 
 using RS = RequestedSettings;
 using C = BoIcpConfig;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 constexpr unsigned kEveryFrontEnd = kRegister | kMap | kSubmit;
 constexpr unsigned kMapFrontEnds = kMap | kSubmit;
@@ -16,98 +20,118 @@ constexpr const char* kNoMapInRegister = "register aligns one pair and builds no
 constexpr const char* kNoMergedCloudLocally =
     "register builds no map, and boicp map writes no merged PLY.";
 
+// What one batch may ask of the daemon. The surrogate grows with the square
+// of the samples and steps of a search, an evaluation's cost with its
+// points, and a ray's with its length over the map's leaf size.
+constexpr RequestLimits kUnbounded{};
+constexpr RequestLimits kSearchSteps{-kInf, 1000.0};
+constexpr RequestLimits kEvaluationPoints{-kInf, 1e6};
+constexpr RequestLimits kRotationHalfWidths{-kInf, M_PI};
+constexpr RequestLimits kTranslationHalfWidths{-kInf, 1000.0};  // metres
+constexpr RequestLimits kRanges{-kInf, 1000.0};                 // metres
+constexpr RequestLimits kCells{0.01, kInf};                     // metres
+
 std::vector<SettingField> BuildSchema() {
   const ProtoMessage kReg = ProtoMessage::kRegistrationConfig;
   const ProtoMessage kMapMsg = ProtoMessage::kMapSettings;
   const ProtoMessage kNone = ProtoMessage::kNone;
   return {
       {"preset", "--config", nullptr, "config", kReg, "preset", kEveryFrontEnd,
-       "BO-ICP preset A, B or C (the paper's)", nullptr, PlainBinding<std::string>{&RS::preset}},
+       "BO-ICP preset A, B or C (the paper's)", nullptr, PlainBinding<std::string>{&RS::preset},
+       kUnbounded},
       {"mode", "--mode", nullptr, "mode", kReg, "mode", kEveryFrontEnd,
-       "nested (rotation then translation) or 6dof", nullptr, PlainBinding<std::string>{&RS::mode}},
+       "nested (rotation then translation) or 6dof", nullptr, PlainBinding<std::string>{&RS::mode},
+       kUnbounded},
       {"seed", "--seed", nullptr, "seed", kReg, "seed", kEveryFrontEnd,
        "Seed of every random choice; each pair's seed derives from it", nullptr,
-       PlainBinding<uint64_t>{&RS::seed}},
+       PlainBinding<uint64_t>{&RS::seed}, kUnbounded},
       {"fixed_settings", "--fixed-settings", nullptr, "fixed_settings", kReg, "fixed_settings",
        kEveryFrontEnd,
        "The preset's fixed voxel, bounds and map settings instead of choosing them from the scans",
-       nullptr, PlainBinding<bool>{&RS::fixed_settings}},
+       nullptr, PlainBinding<bool>{&RS::fixed_settings}, kUnbounded},
       {"no_retry", "--no-retry", nullptr, "no_retry", kReg, "no_retry", kEveryFrontEnd | kBench,
-       "Never search a doubtful pair again", nullptr, PlainBinding<bool>{&RS::no_retry}},
+       "Never search a doubtful pair again", nullptr, PlainBinding<bool>{&RS::no_retry},
+       kUnbounded},
       {"voxel", "--voxel", nullptr, "voxel", kReg, "voxel", kEveryFrontEnd | kBench,
        "Search voxel (metres); default: from the scans", nullptr,
-       OptionalBinding<double>{&RS::voxel, &C::voxel}},
+       OptionalBinding<double>{&RS::voxel, &C::voxel}, kUnbounded},
       {"random_samples", "--random-samples", nullptr, "random_samples", kReg, "random_samples",
        kEveryFrontEnd, "N_r: space-filling samples per search stage; default: the preset's",
-       nullptr, OptionalBinding<int>{&RS::random_samples, &C::random_samples}},
+       nullptr, OptionalBinding<int>{&RS::random_samples, &C::random_samples}, kSearchSteps},
       {"iterations", "--iterations", nullptr, "iterations", kReg, "iterations", kEveryFrontEnd,
        "N: BO iterations per search stage; default: the preset's", nullptr,
-       OptionalBinding<int>{&RS::iterations, &C::iterations}},
+       OptionalBinding<int>{&RS::iterations, &C::iterations}, kSearchSteps},
       {"rotation_bounds", "--rotation-bounds", nullptr, "rotation_bounds", kReg, "rotation_bounds",
        kEveryFrontEnd | kBench,
        "Half-widths roll,pitch,yaw (radians, or pi); default: from the sensor", nullptr,
-       OptionalBinding<Eigen::Vector3d>{&RS::rotation_bounds, &C::rotation_bounds}},
+       OptionalBinding<Eigen::Vector3d>{&RS::rotation_bounds, &C::rotation_bounds},
+       kRotationHalfWidths},
       {"translation_bounds", "--translation-bounds", nullptr, "translation_bounds", kReg,
        "translation_bounds", kEveryFrontEnd | kBench,
        "Half-widths x,y,z (metres); default: from the scans", nullptr,
-       OptionalBinding<Eigen::Vector3d>{&RS::translation_bounds, &C::translation_bounds}},
+       OptionalBinding<Eigen::Vector3d>{&RS::translation_bounds, &C::translation_bounds},
+       kTranslationHalfWidths},
       {"evaluation_points", "--evaluation-points", nullptr, "evaluation_points", kReg,
        "evaluation_points", kEveryFrontEnd, "Source points each evaluation uses (0 = all)", nullptr,
-       OptionalBinding<uint64_t>{&RS::evaluation_points, &C::evaluation_points}},
+       OptionalBinding<uint64_t>{&RS::evaluation_points, &C::evaluation_points}, kEvaluationPoints},
       {"refine_voxel", "--refine-voxel", nullptr, "refine_voxel", kReg, "refine_voxel",
        kEveryFrontEnd, "Finest voxel of the final ICP (metres); default: from the scans", nullptr,
-       OptionalBinding<double>{&RS::refine_voxel, &C::refine_voxel, &C::EffectiveRefineVoxel}},
+       OptionalBinding<double>{&RS::refine_voxel, &C::refine_voxel, &C::EffectiveRefineVoxel},
+       kUnbounded},
       {"max_correspondence", "--max-correspondence", nullptr, "max_correspondence", kReg,
        "max_correspondence", kEveryFrontEnd,
        "ICP correspondence gate during the search (metres); default 3 x voxel", nullptr,
        OptionalBinding<double>{&RS::max_correspondence, &C::max_correspondence_distance,
-                               &C::EffectiveMaxCorrespondence}},
+                               &C::EffectiveMaxCorrespondence},
+       kUnbounded},
       {"min_range", "--min-range", nullptr, "min_range", kReg, "min_range", kEveryFrontEnd,
        "Drop scan points closer to the sensor than this (metres)", nullptr,
-       OptionalBinding<double>{&RS::min_range, &C::min_range}},
+       OptionalBinding<double>{&RS::min_range, &C::min_range}, kRanges},
       // --max-range of map and submit is the OctoMap ray cut.
       {"scan_max_range", "--max-range", "--scan-max-range", "scan_max_range", kReg, "max_range",
        kEveryFrontEnd, "Drop scan points farther from the sensor than this (metres; 0 = none)",
-       nullptr, OptionalBinding<double>{&RS::scan_max_range, &C::max_range}},
+       nullptr, OptionalBinding<double>{&RS::scan_max_range, &C::max_range}, kRanges},
       {"objective_truncation", "--objective-truncation", nullptr, "objective_truncation", kNone, "",
        kRegister, "Clipping distance of the search objective (metres); default 1.5 x voxel",
        kNotInApi,
        OptionalBinding<double>{&RS::objective_truncation, &C::objective_truncation,
-                               &C::EffectiveTruncation}},
+                               &C::EffectiveTruncation},
+       kUnbounded},
       {"icp_iterations", "--icp-iterations", nullptr, "icp_iterations", kNone, "", kRegister,
        "ICP iterations per evaluation", kNotInApi,
-       OptionalBinding<int>{&RS::icp_iterations, &C::icp_max_iterations}},
+       OptionalBinding<int>{&RS::icp_iterations, &C::icp_max_iterations}, kUnbounded},
       {"coarse_icp_points", "--coarse-icp-points", nullptr, "coarse_icp_points", kNone, "",
        kRegister, "Points each evaluation's ICP starts on before it finishes on all (0 = all)",
-       kNotInApi, OptionalBinding<uint64_t>{&RS::coarse_icp_points, &C::coarse_icp_points}},
+       kNotInApi, OptionalBinding<uint64_t>{&RS::coarse_icp_points, &C::coarse_icp_points},
+       kUnbounded},
       {"threads", "--threads", nullptr, "threads", kNone, "", kRegister,
        "Threads for the search and the refinement (default: every core; the answer does not "
        "depend on it)",
        "Map and the daemon run one registration thread per pair and spread pairs over threads "
        "(map --threads, boicpd --registration-threads).",
-       OptionalBinding<int>{&RS::threads, &C::threads}},
+       OptionalBinding<int>{&RS::threads, &C::threads}, kUnbounded},
 
       {"resolution", "--resolution", nullptr, "resolution", kMapMsg, "resolution", kMapFrontEnds,
        "OctoMap leaf size (metres); default: from the scans", kNoMapInRegister,
-       OptionalBinding<double>{&RS::resolution}},
+       OptionalBinding<double>{&RS::resolution}, kCells},
       {"max_range", "--max-range", nullptr, "max_range", kMapMsg, "max_range", kMapFrontEnds,
        "OctoMap ray length (metres), 0 = no limit; default: from the scans", kNoMapInRegister,
-       OptionalBinding<double>{&RS::max_range}},
+       OptionalBinding<double>{&RS::max_range}, kRanges},
       {"prob_hit", "--prob-hit", nullptr, "prob_hit", kMapMsg, "sensor_model.prob_hit",
        kMapFrontEnds, "OctoMap hit probability, in (0.5, 1); default 0.7", kNoMapInRegister,
-       OptionalBinding<double>{&RS::prob_hit}},
+       OptionalBinding<double>{&RS::prob_hit}, kUnbounded},
       {"prob_miss", "--prob-miss", nullptr, "prob_miss", kMapMsg, "sensor_model.prob_miss",
        kMapFrontEnds, "OctoMap miss probability, in (0, 0.5); default 0.4", kNoMapInRegister,
-       OptionalBinding<double>{&RS::prob_miss}},
+       OptionalBinding<double>{&RS::prob_miss}, kUnbounded},
       {"clamp_min", "--clamp-min", nullptr, "clamp_min", kMapMsg, "sensor_model.clamp_min",
        kMapFrontEnds, "OctoMap lower clamping probability; default 0.12", kNoMapInRegister,
-       OptionalBinding<double>{&RS::clamp_min}},
+       OptionalBinding<double>{&RS::clamp_min}, kUnbounded},
       {"clamp_max", "--clamp-max", nullptr, "clamp_max", kMapMsg, "sensor_model.clamp_max",
        kMapFrontEnds, "OctoMap upper clamping probability; default 0.97", kNoMapInRegister,
-       OptionalBinding<double>{&RS::clamp_max}},
+       OptionalBinding<double>{&RS::clamp_max}, kUnbounded},
       {"cloud_voxel", "--cloud-voxel", nullptr, "cloud_voxel", kMapMsg, "cloud_voxel", kSubmit,
        "Voxel of the exported merged PLY (metres); default: the resolution", kNoMergedCloudLocally,
-       OptionalBinding<double>{&RS::cloud_voxel}},
+       OptionalBinding<double>{&RS::cloud_voxel}, kCells},
   };
 }
 

@@ -11,12 +11,27 @@ namespace {
 
 using nlohmann::json;
 
+// The two shapes settings take in JSON.
+enum class Shape {
+  kGiven,  // run.json: run.json keys, null when unset, bounds as typed ("a,b,c")
+  kUsed,   // a config as used: setting names, bounds as three numbers
+};
+
+const char* KeyOf(const SettingField& field, Shape shape) {
+  return shape == Shape::kUsed ? field.name : field.json_key;
+}
+
 template <typename T>
 json OptionalToJson(const std::optional<T>& value) {
   return value ? json(*value) : json(nullptr);
 }
 
-// Bounds are "a,b,c" text (as typed, "pi" allowed); arrays are read too.
+json TripleToJson(const std::optional<Eigen::Vector3d>& value, Shape shape) {
+  if (shape == Shape::kGiven) return value ? FormatTriple(*value) : std::string();
+  return value ? json{(*value)[0], (*value)[1], (*value)[2]} : json(nullptr);
+}
+
+// Bounds are "a,b,c" text (as typed, "pi" allowed) or three numbers.
 Eigen::Vector3d TripleFromJson(const json& value, const std::string& key) {
   if (value.is_array()) {
     const std::vector<double> numbers = value.get<std::vector<double>>();
@@ -26,9 +41,7 @@ Eigen::Vector3d TripleFromJson(const json& value, const std::string& key) {
   return ParseTriple(value.get<std::string>(), key);
 }
 
-}  // namespace
-
-json SettingsToJson(const RequestedSettings& settings, unsigned frontends) {
+json FieldsToJson(const RequestedSettings& settings, unsigned frontends, Shape shape) {
   json out = json::object();
   for (const SettingField& field : SettingSchema()) {
     if ((field.frontends & frontends) == 0) continue;
@@ -36,12 +49,13 @@ json SettingsToJson(const RequestedSettings& settings, unsigned frontends) {
         [&](const auto& binding) {
           using Binding = std::decay_t<decltype(binding)>;
           const auto& value = settings.*binding.requested;
+          json& slot = out[KeyOf(field, shape)];
           if constexpr (std::is_same_v<Binding, OptionalBinding<Eigen::Vector3d>>) {
-            out[field.json_key] = value ? FormatTriple(*value) : std::string();
+            slot = TripleToJson(value, shape);
           } else if constexpr (kIsPlainBinding<Binding>) {
-            out[field.json_key] = value;
+            slot = value;
           } else {
-            out[field.json_key] = OptionalToJson(value);
+            slot = OptionalToJson(value);
           }
         },
         field.binding);
@@ -49,11 +63,11 @@ json SettingsToJson(const RequestedSettings& settings, unsigned frontends) {
   return out;
 }
 
-void SettingsFromJson(const json& in, unsigned frontends, const std::string& source,
-                      RequestedSettings& settings) {
+void FieldsFromJson(const json& in, unsigned frontends, Shape shape, const std::string& source,
+                    RequestedSettings& settings) {
   for (const SettingField& field : SettingSchema()) {
     if ((field.frontends & frontends) == 0) continue;
-    const std::string key = field.json_key;
+    const std::string key = KeyOf(field, shape);
     if (!in.contains(key) || in.at(key).is_null()) continue;
     const json& value = in.at(key);
     try {
@@ -71,10 +85,42 @@ void SettingsFromJson(const json& in, unsigned frontends, const std::string& sou
           },
           field.binding);
     } catch (const json::exception& e) {
-      throw InputError(source + ": bad run settings (" + key + ": " + e.what() + ")");
+      throw InputError(source + ": bad settings (" + key + ": " + e.what() + ")");
     } catch (const InputError& e) {
-      throw InputError(source + ": bad run settings (" + e.what() + ")");
+      throw InputError(source + ": bad settings (" + e.what() + ")");
     }
+  }
+}
+
+}  // namespace
+
+json SettingsToJson(const RequestedSettings& settings, unsigned frontends) {
+  return FieldsToJson(settings, frontends, Shape::kGiven);
+}
+
+void SettingsFromJson(const json& in, unsigned frontends, const std::string& source,
+                      RequestedSettings& settings) {
+  FieldsFromJson(in, frontends, Shape::kGiven, source, settings);
+}
+
+json UsedSettingsToJson(const RequestedSettings& used) {
+  // kRegister takes exactly the registration settings.
+  json out = FieldsToJson(used, kRegister, Shape::kUsed);
+  out.erase("fixed_settings");
+  return out;
+}
+
+json ConfigToJson(const BoIcpConfig& config) {
+  return UsedSettingsToJson(SettingsFromConfig(config));
+}
+
+BoIcpConfig ConfigFromJson(const json& in, const std::string& source) {
+  RequestedSettings settings;
+  FieldsFromJson(in, kRegister, Shape::kUsed, source, settings);
+  try {
+    return ConfigFromSettings(settings);
+  } catch (const InputError& e) {
+    throw InputError(source + ": bad settings (" + e.what() + ")");
   }
 }
 

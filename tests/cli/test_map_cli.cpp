@@ -15,6 +15,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -158,6 +159,54 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   EXPECT_EQ(pairs[0]["doubtful"], false);
   EXPECT_TRUE(pairs[0]["overlap"].is_null());
   EXPECT_EQ(pairs[2]["doubtful"], true);
+}
+
+// A pair file's config object as it was written before it followed the
+// settings schema: three settings under other names, the retry switch the
+// other way round, and engine constants no front end sets.
+json OlderPairConfig(const json& config) {
+  json old = config;
+  const std::pair<const char*, const char*> renamed[] = {
+      {"max_correspondence", "max_correspondence_distance"},
+      {"icp_iterations", "icp_max_iterations"},
+      {"scan_max_range", "max_range"}};
+  for (const auto& [key, old_key] : renamed) {
+    old[old_key] = old.at(key);
+    old.erase(key);
+  }
+  old["retry_when_doubtful"] = !old.at("no_retry").get<bool>();
+  old.erase("no_retry");
+  old["finish_icp_iterations"] = 5;
+  old["refine_max_iterations"] = 60;
+  old["refine_candidates"] = 3;
+  old["refine_source_points"] = 10000;
+  old["inlier_distance"] = 1.5 * old.at("refine_voxel").get<double>();
+  return old;
+}
+
+TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
+  const fs::path scans = MakeDrive(4);
+  const fs::path out = dir_ / "out";
+  const std::string args = "map " + scans.string() + " -o " + out.string() + Quick() + " --json";
+  const RunResult first = Run(args);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const std::string trajectory = Slurp(out / "trajectory.kitti");
+  for (const char* name : {"000000-000001.json", "000001-000002.json", "000002-000003.json"}) {
+    EditPairFile(out / "pairs" / name, [](json& j) {
+      j["settings"]["config"] = OlderPairConfig(j["settings"]["config"]);
+    });
+  }
+  // One of them computed with another ICP gate: registered again.
+  EditPairFile(out / "pairs" / "000002-000003.json",
+               [](json& j) { j["settings"]["config"]["max_correspondence_distance"] = 0.123; });
+  const RunResult again = Run(args);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(json::parse(again.out)["pairs_reused"], 2);
+  EXPECT_EQ(Slurp(out / "trajectory.kitti"), trajectory);
+  const json kept = json::parse(Slurp(out / "pairs" / "000000-000001.json"));
+  EXPECT_TRUE(kept["settings"]["config"].contains("retry_when_doubtful")) << "rewritten";
+  const json redone = json::parse(Slurp(out / "pairs" / "000002-000003.json"));
+  EXPECT_TRUE(redone["settings"]["config"].contains("no_retry")) << "not registered again";
 }
 
 TEST_F(MapCli, GeneratedDriveWritesEveryOutputAndRerunsReusePairs) {

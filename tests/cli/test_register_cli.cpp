@@ -64,6 +64,9 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   EXPECT_EQ(j["config"]["rotation_bounds"][2].get<double>(), M_PI);
   EXPECT_EQ(j["auto"], nlohmann::json({"voxel", "refine_voxel", "objective_truncation",
                                        "translation_bounds"}));
+  for (const nlohmann::json& name : j["auto"]) {
+    EXPECT_TRUE(j["config"].contains(name.get<std::string>())) << name << " names no setting";
+  }
   EXPECT_FALSE(j["doubtful"].get<bool>());
   ASSERT_EQ(j["attempts"].size(), 1u);
   EXPECT_EQ(j["attempts"][0]["mode"], "nested");
@@ -80,7 +83,11 @@ TEST_F(Cli, FixedSettingsAndNoRetry) {
   EXPECT_TRUE(j["auto"].empty());
   EXPECT_DOUBLE_EQ(j["config"]["voxel"].get<double>(), 0.7);
   EXPECT_EQ(j["config"]["translation_bounds"], nlohmann::json({4.0, 2.0, 1.0}));
-  EXPECT_FALSE(j["config"]["retry_when_doubtful"].get<bool>());
+  EXPECT_TRUE(j["config"]["no_retry"].get<bool>());
+  // The "0 = from the voxel" settings are reported as used.
+  EXPECT_DOUBLE_EQ(j["config"]["max_correspondence"].get<double>(), 3.0 * 0.7);
+  EXPECT_DOUBLE_EQ(j["config"]["objective_truncation"].get<double>(), 1.5 * 0.7);
+  EXPECT_DOUBLE_EQ(j["config"]["refine_voxel"].get<double>(), 0.7 / 4.0);
   EXPECT_EQ(j["attempts"].size(), 1u);
 }
 

@@ -183,6 +183,14 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_EQ(j["job_id"], job);
   EXPECT_EQ(j["state"], "succeeded");
   EXPECT_EQ(j["label"], "drive4");
+  // The settings used, under the names run.json's "chosen" has.
+  const nlohmann::json& used = j["settings"];
+  EXPECT_EQ(used["preset"], "A");
+  EXPECT_EQ(used["random_samples"], 4);
+  EXPECT_EQ(used["rotation_bounds"], nlohmann::json({0.2, 0.2, M_PI}));
+  EXPECT_EQ(used["no_retry"], false);
+  EXPECT_GT(used["voxel"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(used["map_resolution"].get<double>(), 0.3);
   ASSERT_EQ(j["pairs"].size(), 3u);
   ASSERT_EQ(j["trajectory"].size(), 4u);
   int doubtful = 0;

@@ -1,6 +1,9 @@
-// The settings schema: every field reaches BoIcpConfig from its flag, and
-// every field survives run.json.
+// The settings schema: every field reaches BoIcpConfig from its flag, every
+// field survives run.json, and a config as used (register --json, pair
+// files, run.json's chosen) names every registration setting, resolved, and
+// reads back.
 
+#include <cmath>
 #include <set>
 
 #include <gmock/gmock.h>
@@ -24,6 +27,12 @@ TEST(SettingSchema, NamesAreUniqueAndEveryApiGapIsExplained) {
     EXPECT_EQ(field.absent_because == nullptr, everywhere) << field.name;
     EXPECT_EQ(field.message == ProtoMessage::kNone, std::string(field.proto_field).empty())
         << field.name;
+    // Limits bound what a request gives a number.
+    const bool bounded = std::isfinite(field.limits.lower) || std::isfinite(field.limits.upper);
+    const bool number = std::visit(
+        [](const auto& binding) { return !kIsPlainBinding<std::decay_t<decltype(binding)>>; },
+        field.binding);
+    EXPECT_TRUE(!bounded || (number && field.message != ProtoMessage::kNone)) << field.name;
     // Whatever the API takes, submit must be able to send.
     if (field.message != ProtoMessage::kNone) {
       EXPECT_TRUE(field.frontends & kSubmit) << field.name;
@@ -71,6 +80,48 @@ TEST(SettingSchema, EveryMapAndSubmitFlagSurvivesRunJson) {
     EXPECT_EQ(AllFields(read_back), AllFields(given)) << frontend;
     EXPECT_NE(AllFields(given), AllFields(RequestedSettings())) << frontend;
   }
+}
+
+TEST(SettingSchema, ConfigAsUsedNamesEveryRegistrationSettingAndReadsBack) {
+  const BoIcpConfig config = ConfigFromSettings(ParseFlags(kRegister, ExampleArguments(kRegister)));
+  const nlohmann::json used = ConfigToJson(config);
+  std::set<std::string> expected;
+  for (const SettingField& field : SettingSchema()) {
+    if ((field.frontends & kRegister) != 0) expected.insert(field.name);
+  }
+  expected.erase("fixed_settings");
+  std::set<std::string> keys;
+  for (const auto& item : used.items()) keys.insert(item.key());
+  EXPECT_EQ(keys, expected);
+  EXPECT_EQ(used["preset"], "B");
+  EXPECT_EQ(used["no_retry"], true);
+  EXPECT_EQ(used["rotation_bounds"], nlohmann::json({0.25, 0.5, 1.25}));
+
+  const BoIcpConfig read_back = ConfigFromJson(used, "test");
+  EXPECT_EQ(ConfigToJson(read_back), used);
+  EXPECT_TRUE(read_back.automatic.empty());
+  EXPECT_EQ(AllFields(SettingsFromConfig(read_back)), AllFields(SettingsFromConfig(config)));
+
+  nlohmann::json bad = used;
+  bad["voxel"] = "fine";
+  EXPECT_THROW(ConfigFromJson(bad, "test"), InputError);
+  bad["voxel"] = -1.0;
+  EXPECT_THROW(ConfigFromJson(bad, "test"), InputError);
+}
+
+TEST(SettingSchema, ConfigAsUsedReportsTheDerivedValues) {
+  BoIcpConfig config = PresetConfig("C");
+  config.voxel = 0.8;
+  config.max_correspondence_distance = 0.0;  // 0 = 3 x voxel
+  config.objective_truncation = 0.0;         // 0 = 1.5 x voxel
+  config.refine_voxel = 0.0;                 // 0 = voxel / 4
+  const nlohmann::json used = ConfigToJson(config);
+  EXPECT_DOUBLE_EQ(used["max_correspondence"].get<double>(), config.EffectiveMaxCorrespondence());
+  EXPECT_DOUBLE_EQ(used["objective_truncation"].get<double>(), config.EffectiveTruncation());
+  EXPECT_DOUBLE_EQ(used["refine_voxel"].get<double>(), config.EffectiveRefineVoxel());
+  EXPECT_DOUBLE_EQ(used["max_correspondence"].get<double>(), 2.4);
+  EXPECT_DOUBLE_EQ(used["objective_truncation"].get<double>(), 1.2);
+  EXPECT_DOUBLE_EQ(used["refine_voxel"].get<double>(), 0.2);
 }
 
 TEST(SettingSchema, MapAndSubmitSpellTheScanRangeApartFromTheRayCut) {

@@ -5,11 +5,17 @@
 #include <string>
 
 #include "boicp/settings/requested_settings.hpp"
+#include "boicp/settings/setting_schema.hpp"
 #include "boicp/v1/map_builder.pb.h"
 
 namespace boicp::rpc {
 
 namespace v1 = ::boicp::v1;
+
+/// The field's path in a SubmitBatchRequest, as error messages name it:
+/// "config.random_samples", "map.sensor_model.prob_hit". Precondition: the
+/// API takes the field (message is not kNone).
+std::string ProtoFieldPath(const settings::SettingField& field);
 
 /// The given registration settings; unset ones stay unset, so the daemon
 /// applies the same preset defaults. Throws InputError for a value the

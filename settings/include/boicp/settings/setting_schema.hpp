@@ -1,14 +1,17 @@
 #pragma once
 // The one description of every registration and map setting: its name in
 // each front end (CLI flag, run.json key, boicp.v1 proto field), its help
-// text, and where its value lives. Flags, run.json, the proto conversions
-// and the bench are all generated from this table, so a setting added here
-// reaches every front end at once. BoIcpConfig fields missing from the table
-// (finish_icp_iterations, refine_max_iterations, refine_candidates,
-// refine_source_points, inlier_distance, retry_voxel, bo) are engine tuning
-// that no front end and not the API takes.
+// text, where its value lives and what a request to the daemon may give it.
+// Flags, run.json, the settings-as-used JSON (register --json, pair files),
+// the proto conversions, the daemon's request limits and the bench are all
+// generated from this table, so a setting added here reaches every front end
+// at once. BoIcpConfig fields missing from the table (finish_icp_iterations,
+// refine_max_iterations, refine_candidates, refine_source_points,
+// inlier_distance, retry_voxel, bo) are engine tuning that no front end and
+// not the API takes.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <variant>
@@ -75,6 +78,17 @@ enum class ProtoMessage {
   kMapSettings,         // boicp.v1.MapSettings
 };
 
+/// The values a request to the daemon may give a number setting (each
+/// component of three-number settings), so that no batch makes it allocate
+/// or compute without limit. Only given values are checked ("0 = from the
+/// scans" stays allowed). The commands that run on the user's own machine
+/// do not apply them; whether a value makes sense at all (a positive voxel)
+/// is ValidateConfig's and ValidateOccupancySettings' to say.
+struct RequestLimits {
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+};
+
 struct SettingField {
   const char* name;      // identifier; for the registration fields the name
                          // BoIcpConfig::MarkSet and "auto" use
@@ -89,6 +103,7 @@ struct SettingField {
   /// register, the proto); nullptr when it is in all of them.
   const char* absent_because;
   SettingBinding binding;
+  RequestLimits limits;  // RequestLimits{} (unbounded) where no value costs the daemon much
 };
 
 /// Every setting, registration fields first, in the order help lists them.
