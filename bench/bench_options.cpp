@@ -60,6 +60,7 @@ void ApplySchemaSettings(const settings::RequestedSettings& given, DatasetOverri
   o.rotation_bounds = given.rotation_bounds;
   o.translation_bounds = given.translation_bounds;
   o.retry_when_doubtful = !given.no_retry;
+  o.icp_objective = given.icp_objective;
 }
 
 }  // namespace

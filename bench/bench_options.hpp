@@ -31,8 +31,9 @@ struct DatasetOverrides {
   std::optional<Eigen::Vector3d> translation_bounds;
   std::optional<double> max_rot_deg;  // success thresholds
   std::optional<double> max_trans_m;
-  bool automatic_settings = false;  // BO methods choose voxel and boxes from the clouds
-  bool retry_when_doubtful = true;  // BO methods search again when doubtful
+  bool automatic_settings = false;      // BO methods choose voxel and boxes from the clouds
+  bool retry_when_doubtful = true;      // BO methods search again when doubtful
+  std::string icp_objective = "plane";  // BO methods' search evaluations: plane | point
 };
 
 struct BenchOptions {

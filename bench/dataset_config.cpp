@@ -15,6 +15,7 @@ BoIcpConfig PresetForDataset(const std::string& preset, const MethodInput& input
   given.seed = input.seed;
   given.threads = input.threads;
   given.no_retry = !input.dataset.retry_when_doubtful;
+  given.icp_objective = input.dataset.icp_objective;
   if (!automatic) {
     given.fixed_settings = true;
     given.voxel = input.dataset.voxel * preset_config.voxel / PresetConfig("C").voxel;

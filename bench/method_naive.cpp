@@ -26,7 +26,8 @@ MethodOutput RunNaiveBoIcp(const MethodInput& input) {
   ApplyChosenSettings(
       ChooseSettingsForClouds({&input.source, &input.target}, CloudFormat::kAuto, config.seed),
       config);
-  config.retry_when_doubtful = false;  // the paper's method searches once
+  config.retry_when_doubtful = false;                  // the paper's method searches once
+  config.icp_objective = IcpObjective::kPointToPoint;  // what local_icp below runs
   config.bo.batch_size = 1;
   config.bo.refit_every = 1;
   config.evaluation_points = 0;

@@ -58,6 +58,8 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
     if (config.contains(old_key)) config[key] = config.at(old_key);
   }
   config["no_retry"] = !config.at("retry_when_doubtful").get<bool>();
+  // Their searches ran point-to-point ICP, the only one there was.
+  if (!config.contains("icp_objective")) config["icp_objective"] = "point";
   config = PairConfigJson(settings::ConfigFromJson(config, source));
 }
 

@@ -25,6 +25,7 @@ BoIcpConfig ConfigFromSettings(const RequestedSettings& settings) {
   BoIcpConfig config = PresetConfig(settings.preset);
   if (settings.fixed_settings) config.automatic.clear();
   config.mode = ParseSearchMode(settings.mode);
+  config.icp_objective = ParseIcpObjective(settings.icp_objective);
   config.retry_when_doubtful = !settings.no_retry;
   config.seed = settings.seed;
   for (const SettingField& field : SettingSchema()) {
@@ -47,6 +48,7 @@ RequestedSettings SettingsFromConfig(const BoIcpConfig& config) {
   RequestedSettings settings;
   settings.preset = config.preset;
   settings.mode = SearchModeName(config.mode);
+  settings.icp_objective = IcpObjectiveName(config.icp_objective);
   settings.seed = config.seed;
   settings.no_retry = !config.retry_when_doubtful;
   for (const SettingField& field : SettingSchema()) {

@@ -42,6 +42,11 @@ std::vector<SettingField> BuildSchema() {
       {"mode", "--mode", nullptr, "mode", kReg, "mode", kEveryFrontEnd,
        "nested (rotation then translation) or 6dof", nullptr, PlainBinding<std::string>{&RS::mode},
        kUnbounded},
+      {"icp_objective", "--icp-objective", nullptr, "icp_objective", kReg, "icp_objective",
+       kEveryFrontEnd | kBench,
+       "ICP of the search evaluations: plane (point-to-plane, fewer iterations) or point (the "
+       "paper's point-to-point)",
+       nullptr, PlainBinding<std::string>{&RS::icp_objective}, kUnbounded},
       {"seed", "--seed", nullptr, "seed", kReg, "seed", kEveryFrontEnd,
        "Seed of every random choice; each pair's seed derives from it", nullptr,
        PlainBinding<uint64_t>{&RS::seed}, kUnbounded},

@@ -163,7 +163,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
 
 // A pair file's config object as it was written before it followed the
 // settings schema: three settings under other names, the retry switch the
-// other way round, and engine constants no front end sets.
+// other way round, engine constants no front end sets, and no ICP objective.
 json OlderPairConfig(const json& config) {
   json old = config;
   const std::pair<const char*, const char*> renamed[] = {
@@ -176,6 +176,7 @@ json OlderPairConfig(const json& config) {
   }
   old["retry_when_doubtful"] = !old.at("no_retry").get<bool>();
   old.erase("no_retry");
+  old.erase("icp_objective");  // point-to-point was the only one
   old["finish_icp_iterations"] = 5;
   old["refine_max_iterations"] = 60;
   old["refine_candidates"] = 3;
@@ -187,7 +188,8 @@ json OlderPairConfig(const json& config) {
 TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
   const fs::path scans = MakeDrive(4);
   const fs::path out = dir_ / "out";
-  const std::string args = "map " + scans.string() + " -o " + out.string() + Quick() + " --json";
+  const std::string args =
+      "map " + scans.string() + " -o " + out.string() + Quick() + " --json --icp-objective point";
   const RunResult first = Run(args);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   const std::string trajectory = Slurp(out / "trajectory.kitti");

@@ -31,7 +31,7 @@ inline std::vector<std::string> ExampleArguments(Frontend frontend) {
           }
           std::string value;
           if constexpr (std::is_same_v<Binding, PlainBinding<std::string>>) {
-            value = flag == "--mode" ? "6dof" : "B";
+            value = flag == "--mode" ? "6dof" : flag == "--icp-objective" ? "point" : "B";
           } else if constexpr (std::is_same_v<Binding, OptionalBinding<double>>) {
             // The refinement voxel may not exceed the search voxel.
             value = flag == "--refine-voxel" ? "0.25" : std::to_string(n) + ".25";

@@ -184,8 +184,9 @@ TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
   const StreetPair pair = MakeStreetPair(0.9);
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 3;
-  config.coarse_icp_points = 0;        // the hook runs every ICP in one part...
-  config.join_converged_runs = false;  // ...and to its own end
+  config.coarse_icp_points = 0;                        // the hook runs every ICP in one part...
+  config.join_converged_runs = false;                  // ...and to its own end
+  config.icp_objective = IcpObjective::kPointToPoint;  // as the hook below
   const RegistrationResult plain = RegisterPair(pair.source, pair.target, config);
 
   // A hook that runs core's own ICP must reproduce the search exactly...

@@ -1,4 +1,5 @@
-// Point-to-point ICP, the alignment score and the search box on synthetic data.
+// ICP (point-to-point and point-to-plane), surface normals, the alignment
+// score and the search box on synthetic data.
 
 #include <gtest/gtest.h>
 
@@ -7,6 +8,7 @@
 #include "boicp/registration/icp.hpp"
 #include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/search_space.hpp"
+#include "boicp/registration/surface_normals.hpp"
 
 namespace boicp {
 namespace {
@@ -63,6 +65,58 @@ TEST(Icp, SerialAndParallelGiveIdenticalResults) {
   const AlignmentScore sb = ScoreAlignment(source, index, a.transform, 0.5, 2);
   EXPECT_EQ(sa.truncated_mean, sb.truncated_mean);
   EXPECT_EQ(sa.fitness, sb.fitness);
+}
+
+// A tilted plane sampled on a grid: every normal is the plane's (up to
+// sign); a line of points has none.
+TEST(SurfaceNormals, AreThePlanesNormalAndZeroOnALine) {
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  Points plane;
+  for (int i = 0; i < 20; ++i) {
+    for (int j = 0; j < 20; ++j) plane.push_back(0.1 * i * u + 0.1 * j * v);
+  }
+  const Points normals = EstimateSurfaceNormals(NearestNeighborIndex(plane), 0.3, 2);
+  ASSERT_EQ(normals.size(), plane.size());
+  for (const Point& n : normals) EXPECT_NEAR(std::abs(n.dot(normal)), 1.0, 1e-9);
+
+  Points line;
+  for (int i = 0; i < 20; ++i) line.push_back(Point(0.1 * i, 0.0, 0.0));
+  for (const Point& n : EstimateSurfaceNormals(NearestNeighborIndex(line), 0.3, 1)) {
+    EXPECT_TRUE(n.isZero());
+  }
+}
+
+// On the street, point-to-plane reaches the same transform as point-to-point
+// in fewer iterations, and its result does not depend on the thread count.
+TEST(Icp, PointToPlaneConvergesInFewerIterationsToTheSameTransform) {
+  const MovedStreet street;
+  const Points normals = EstimateSurfaceNormals(street.index, 0.9, 1);
+  IcpOptions options;
+  options.max_correspondence_distance = 1.0;
+  options.max_iterations = 100;
+  options.convergence_translation = 1e-6;
+  options.convergence_rotation = 1e-7;
+  const IcpResult point =
+      AlignPointToPoint(street.source, street.index, Transform::Identity(), options);
+  const IcpResult plane =
+      AlignPointToPlane(street.source, street.index, normals, Transform::Identity(), options);
+  ASSERT_TRUE(point.converged);
+  ASSERT_TRUE(plane.converged);
+  EXPECT_LT(RotationAngle(plane.transform.inverse() * SmallMotion()), 1e-4);
+  EXPECT_LT(TranslationNorm(plane.transform.inverse() * SmallMotion()), 1e-3);
+  EXPECT_LT(plane.iterations * 2, point.iterations)
+      << plane.iterations << " point-to-plane iterations vs " << point.iterations;
+
+  IcpOptions parallel = options;
+  parallel.threads = 2;
+  const IcpResult twin =
+      AlignPointToPlane(street.source, street.index, normals, Transform::Identity(), parallel);
+  EXPECT_TRUE(twin.transform == plane.transform);
+  EXPECT_EQ(twin.iterations, plane.iterations);
+  EXPECT_THROW(AlignPointToPlane(street.source, street.index, Points(3, Point::UnitZ()),
+                                 Transform::Identity(), options),
+               InputError);
 }
 
 TEST(Icp, ProjectedLimitExtrapolatesTheFasterOfTheLastTwoSteps) {

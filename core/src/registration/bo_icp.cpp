@@ -100,17 +100,20 @@ class Search {
       evaluation.result = callbacks_.local_icp(pair_.evaluation_source, target.points(), initial);
     } else {
       IcpOptions options = pair_.search_icp;
+      const auto align = [&](const Points& source, const Transform& from) {
+        return config_.icp_objective == IcpObjective::kPointToPlane
+                   ? AlignPointToPlane(source, target, pair_.prepared.search_target_normals, from,
+                                       options, known_ends_)
+                   : AlignPointToPoint(source, target, from, options, known_ends_);
+      };
       IcpResult icp;
       icp.transform = initial;
       if (pair_.coarse_source.size() < pair_.evaluation_source.size()) {
-        icp = AlignPointToPoint(pair_.coarse_source, target, initial, options, known_ends_);
+        icp = align(pair_.coarse_source, initial);
         options.max_iterations =
             std::max(options.max_iterations - icp.iterations, config_.finish_icp_iterations);
       }
-      if (icp.joined_end < 0) {
-        icp =
-            AlignPointToPoint(pair_.evaluation_source, target, icp.transform, options, known_ends_);
-      }
+      if (icp.joined_end < 0) icp = align(pair_.evaluation_source, icp.transform);
       evaluation.result = icp.transform;
       if (icp.joined_end >= 0) {
         evaluation.objective = known_objectives_[icp.joined_end];

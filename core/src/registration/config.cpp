@@ -18,6 +18,16 @@ std::string SearchModeName(SearchMode mode) {
   return mode == SearchMode::kNested ? "nested" : "6dof";
 }
 
+IcpObjective ParseIcpObjective(const std::string& name) {
+  if (name == "point") return IcpObjective::kPointToPoint;
+  if (name == "plane") return IcpObjective::kPointToPlane;
+  throw InputError("unknown ICP objective '" + name + "' (expected point or plane)");
+}
+
+std::string IcpObjectiveName(IcpObjective objective) {
+  return objective == IcpObjective::kPointToPoint ? "point" : "plane";
+}
+
 const std::vector<std::string> kAutoRegistrationFields = {
     "voxel", "refine_voxel", "objective_truncation", "translation_bounds", "rotation_bounds"};
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <Eigen/SVD>
 
@@ -89,16 +90,18 @@ Transform RigidFromCrossCovariance(const Point& source_mean, const Point& target
   return T;
 }
 
-IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& target,
-                            const Transform& initial, const IcpOptions& options,
-                            const std::vector<Transform>& known_ends) {
+namespace {
+
+template <typename SolveStep>
+IcpResult RunIcp(const Points& source, const NearestNeighborIndex& target, const Transform& initial,
+                 const IcpOptions& options, const std::vector<Transform>& known_ends,
+                 const SolveStep& solve_step) {
   IcpResult result;
   result.transform = initial;
   Points moved(source.size());
   std::vector<size_t> match(source.size(), kNoMatch);
   std::vector<double> sq_distance(source.size(), 0.0);
   const double max_sq = options.max_correspondence_distance * options.max_correspondence_distance;
-  const Points& target_points = target.points();
   const bool may_abandon = std::isfinite(options.abandon_above);
   if (may_abandon &&
       !(options.truncation > 0.0 && options.truncation <= options.max_correspondence_distance)) {
@@ -118,16 +121,13 @@ IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& ta
     const Eigen::Vector3d t = result.transform.topRightCorner<3, 1>();
     MatchNearest(source, target, R, t, max_sq, options.threads, moved, match, sq_distance);
 
-    // Serial reduction in index order keeps the sums bit-identical for any thread count.
+    // Serial reductions in index order keep the sums bit-identical for any thread count.
     size_t count = 0;
     double sum_sq = 0.0;
-    Point source_mean = Point::Zero(), target_mean = Point::Zero();
     for (size_t i = 0; i < source.size(); ++i) {
       if (match[i] == kNoMatch) continue;
       ++count;
       sum_sq += sq_distance[i];
-      source_mean += moved[i];
-      target_mean += target_points[match[i]];
     }
     result.iterations = iteration + 1;
     result.correspondences = count;
@@ -148,15 +148,7 @@ IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& ta
         return result;
       }
     }
-    source_mean /= static_cast<double>(count);
-    target_mean /= static_cast<double>(count);
-    Eigen::Matrix3d cross_covariance = Eigen::Matrix3d::Zero();
-    for (size_t i = 0; i < source.size(); ++i) {
-      if (match[i] == kNoMatch) continue;
-      cross_covariance +=
-          (moved[i] - source_mean) * (target_points[match[i]] - target_mean).transpose();
-    }
-    const Transform step = RigidFromCrossCovariance(source_mean, target_mean, cross_covariance);
+    const Transform step = solve_step(moved, match);
     result.transform = step * result.transform;
     if (TranslationNorm(step) < options.convergence_translation &&
         RotationAngle(step) < options.convergence_rotation) {
@@ -165,6 +157,90 @@ IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& ta
     }
   }
   return result;
+}
+
+// The rigid motion that best maps the matched moved points onto their target
+// points (Kabsch). Precondition: at least 3 matches.
+Transform PointToPointStep(const Points& moved, const std::vector<size_t>& match,
+                           const Points& target_points) {
+  size_t count = 0;
+  Point source_mean = Point::Zero(), target_mean = Point::Zero();
+  for (size_t i = 0; i < moved.size(); ++i) {
+    if (match[i] == kNoMatch) continue;
+    ++count;
+    source_mean += moved[i];
+    target_mean += target_points[match[i]];
+  }
+  source_mean /= static_cast<double>(count);
+  target_mean /= static_cast<double>(count);
+  Eigen::Matrix3d cross_covariance = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < moved.size(); ++i) {
+    if (match[i] == kNoMatch) continue;
+    cross_covariance +=
+        (moved[i] - source_mean) * (target_points[match[i]] - target_mean).transpose();
+  }
+  return RigidFromCrossCovariance(source_mean, target_mean, cross_covariance);
+}
+
+// One Gauss-Newton step on the sum of squared distances from the moved points
+// to their matches' tangent planes, linearised in a small rotation w and a
+// translation t: r_i + (p_i x n_i) . w + n_i . t. Matches without a normal do
+// not count; with fewer than 6 that have one, the point-to-point step is used.
+Transform PointToPlaneStep(const Points& moved, const std::vector<size_t>& match,
+                           const Points& target_points, const Points& target_normals) {
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
+  Vector6d Jtr = Vector6d::Zero();
+  size_t used = 0;
+  for (size_t i = 0; i < moved.size(); ++i) {
+    if (match[i] == kNoMatch) continue;
+    const Point& n = target_normals[match[i]];
+    if (n.isZero()) continue;
+    Vector6d J;
+    J << moved[i].cross(n), n;
+    JtJ.selfadjointView<Eigen::Upper>().rankUpdate(J);
+    Jtr += J * (moved[i] - target_points[match[i]]).dot(n);
+    ++used;
+  }
+  if (used < 6) return PointToPointStep(moved, match, target_points);
+  // A direction no plane constrains (along a corridor) gets a near-zero step
+  // instead of an arbitrary one.
+  JtJ.diagonal().array() += 1e-6 * JtJ.trace() / 6.0;
+  const Vector6d x = JtJ.selfadjointView<Eigen::Upper>().ldlt().solve(-Jtr);
+  if (!x.allFinite()) return PointToPointStep(moved, match, target_points);
+  Transform step = Transform::Identity();
+  const Eigen::Vector3d w = x.head<3>();
+  if (w.norm() > 0.0) {
+    step.topLeftCorner<3, 3>() = Eigen::AngleAxisd(w.norm(), w / w.norm()).toRotationMatrix();
+  }
+  step.topRightCorner<3, 1>() = x.tail<3>();
+  return step;
+}
+
+}  // namespace
+
+IcpResult AlignPointToPoint(const Points& source, const NearestNeighborIndex& target,
+                            const Transform& initial, const IcpOptions& options,
+                            const std::vector<Transform>& known_ends) {
+  const Points& target_points = target.points();
+  return RunIcp(source, target, initial, options, known_ends,
+                [&](const Points& moved, const std::vector<size_t>& match) {
+                  return PointToPointStep(moved, match, target_points);
+                });
+}
+
+IcpResult AlignPointToPlane(const Points& source, const NearestNeighborIndex& target,
+                            const Points& target_normals, const Transform& initial,
+                            const IcpOptions& options, const std::vector<Transform>& known_ends) {
+  if (target_normals.size() != target.size()) {
+    throw InputError("point-to-plane ICP: " + std::to_string(target_normals.size()) +
+                     " normals for " + std::to_string(target.size()) + " target points");
+  }
+  const Points& target_points = target.points();
+  return RunIcp(source, target, initial, options, known_ends,
+                [&](const Points& moved, const std::vector<size_t>& match) {
+                  return PointToPlaneStep(moved, match, target_points, target_normals);
+                });
 }
 
 }  // namespace boicp

@@ -1,6 +1,7 @@
 #include "boicp/registration/nearest_neighbors.hpp"
 
 #include <limits>
+#include <vector>
 
 #include <nanoflann.hpp>
 
@@ -90,6 +91,15 @@ bool NearestNeighborIndex::NearestWithHint(const Point& query, size_t hint,
   index = result.index();
   squared_distance = result.worstDist();
   return true;
+}
+
+void NearestNeighborIndex::KNearest(const Point& query, size_t k, double max_squared_distance,
+                                    std::vector<size_t>& indices) const {
+  indices.resize(k);
+  std::vector<double> squared_distances(k);
+  size_t found = tree_->kdtree.knnSearch(query.data(), k, indices.data(), squared_distances.data());
+  while (found > 0 && squared_distances[found - 1] > max_squared_distance) --found;
+  indices.resize(found);
 }
 
 const Points& NearestNeighborIndex::points() const { return tree_->adaptor.points; }

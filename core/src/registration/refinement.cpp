@@ -7,6 +7,7 @@
 #include <string>
 
 #include "boicp/registration/preprocess.hpp"
+#include "boicp/registration/surface_normals.hpp"
 #include "boicp/util/parallel_for.hpp"
 
 namespace boicp {
@@ -70,7 +71,11 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
                                        config.refine_source_points, config.seed ^ kLevelSalt);
     }
   });
-  PreparedPair pair{std::move(sources[0]), std::move(*targets[0]), {}};
+  PreparedPair pair{std::move(sources[0]), std::move(*targets[0]), {}, {}};
+  if (config.icp_objective == IcpObjective::kPointToPlane) {
+    pair.search_target_normals =
+        EstimateSurfaceNormals(pair.search_target, 3.0 * config.voxel, config.threads);
+  }
   for (size_t level = 1; level < voxels.size(); ++level) {
     pair.pyramid.push_back({voxels[level], std::move(sources[level]), std::move(*targets[level])});
   }

@@ -94,7 +94,7 @@ struct RegistrationCallbacks {
   /// measure another ICP implementation against the same search (called from
   /// config.threads threads at once, so it must be thread-safe): aligns
   /// `source` onto `target` from `initial` and returns T_target_source. Empty:
-  /// core's point-to-point ICP against the prebuilt target index.
+  /// core's ICP (config.icp_objective) against the prebuilt target index.
   std::function<Transform(const Points& source, const Points& target, const Transform& initial)>
       local_icp;
 };

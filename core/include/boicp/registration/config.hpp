@@ -19,6 +19,15 @@ enum class SearchMode {
 SearchMode ParseSearchMode(const std::string& name);  // "nested" | "6dof"; throws InputError
 std::string SearchModeName(SearchMode mode);
 
+/// The ICP objective of every search evaluation.
+enum class IcpObjective {
+  kPointToPoint,  // distances to the matched points (the paper's)
+  kPointToPlane,  // distances to the matched points' tangent planes (target normals)
+};
+
+IcpObjective ParseIcpObjective(const std::string& name);  // "point" | "plane"; throws InputError
+std::string IcpObjectiveName(IcpObjective objective);
+
 /// The library's BO settings with 1000 EI candidates per proposal (see
 /// BoIcpConfig::bo).
 BayesOptOptions RegistrationBayesOptOptions();
@@ -59,6 +68,7 @@ struct BoIcpConfig {
   Eigen::Vector3d translation_bounds{4.0, 2.0, 1.0};      // metres (x, y, z), the paper's
 
   // --- ICP run by every evaluation ----------------------------------------
+  IcpObjective icp_objective = IcpObjective::kPointToPlane;
   double max_correspondence_distance = 0.0;  // metres; 0 = 3 x voxel
   // Clipping distance tau of the objective (truncated mean NN distance),
   // metres; 0 = 1.5 x voxel. Tighter than the ICP gate so that a larger but

@@ -31,6 +31,12 @@ class NearestNeighborIndex {
   bool NearestWithHint(const Point& query, size_t hint, double max_squared_distance, size_t& index,
                        double& squared_distance) const;
 
+  /// Up to `k` target points nearest to `query` (nearest first) within
+  /// sqrt(max_squared_distance) metres: their indices go to `indices`, which
+  /// is resized to their number. Thread-safe for concurrent queries.
+  void KNearest(const Point& query, size_t k, double max_squared_distance,
+                std::vector<size_t>& indices) const;
+
   const Points& points() const;
   size_t size() const { return points().size(); }
 

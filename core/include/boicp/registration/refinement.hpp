@@ -37,6 +37,10 @@ struct PyramidLevel {
 struct PreparedPair {
   Points search_source;
   NearestNeighborIndex search_target;
+  /// Normals of search_target's points for point-to-plane evaluations
+  /// (radius 3 search voxels); empty when the config's objective is
+  /// point-to-point.
+  Points search_target_normals;
   /// Voxels halving from config.voxel / 2 down to the refinement voxel, so
   /// every level starts inside the next level's basin; finest last.
   std::vector<PyramidLevel> pyramid;

@@ -19,14 +19,15 @@ namespace boicp::settings {
 /// when BoIcpConfig::automatic (or MapAutoFields) lists them.
 struct RequestedSettings {
   // --- Registration --------------------------------------------------------
-  std::string preset = "C";           // the paper's A, B or C (case-insensitive)
-  std::string mode = "nested";        // nested | 6dof
-  uint64_t seed = 1;                  // job seed; each pair's seed derives from it
-  bool fixed_settings = false;        // the preset's fixed voxel, bounds and map settings
-  bool no_retry = false;              // never search a doubtful pair again
-  std::optional<double> voxel;        // search voxel, metres
-  std::optional<int> random_samples;  // N_r per search stage
-  std::optional<int> iterations;      // N per search stage
+  std::string preset = "C";             // the paper's A, B or C (case-insensitive)
+  std::string mode = "nested";          // nested | 6dof
+  std::string icp_objective = "plane";  // plane | point: the search evaluations' ICP
+  uint64_t seed = 1;                    // job seed; each pair's seed derives from it
+  bool fixed_settings = false;          // the preset's fixed voxel, bounds and map settings
+  bool no_retry = false;                // never search a doubtful pair again
+  std::optional<double> voxel;          // search voxel, metres
+  std::optional<int> random_samples;    // N_r per search stage
+  std::optional<int> iterations;        // N per search stage
   std::optional<Eigen::Vector3d> rotation_bounds;     // half-widths roll, pitch, yaw; radians
   std::optional<Eigen::Vector3d> translation_bounds;  // half-widths x, y, z; metres
   std::optional<uint64_t> evaluation_points;          // source points per evaluation; 0 = all
