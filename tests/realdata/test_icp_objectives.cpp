@@ -19,6 +19,7 @@
 #include "boicp/registration/icp.hpp"
 #include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/surface_normals.hpp"
+#include "shared_data.hpp"
 
 namespace boicp {
 namespace {
@@ -45,16 +46,10 @@ Transform PerturbedStart(const Transform& reference, double voxel, std::mt19937_
 
 TEST_P(IcpObjectives, PointToPlaneReachesTheSameBasinsInFewerIterations) {
   const ObjectiveCase& dataset = GetParam();
-  const std::filesystem::path folder = std::filesystem::path(BOICP_SHARED_DATA_DIR) / dataset.name;
-  if (!std::filesystem::exists(folder / "pairs.csv")) {
-    GTEST_SKIP() << "real data not found at " << folder.string()
-                 << " (../shared/data beside the project root); skipping";
-  }
-  LoadOptions load;
-  if (dataset.depth_images) {
-    load.depth.intrinsics = ReadIntrinsicsFile((folder / "camera-intrinsics.txt").string());
-    load.depth.depth_scale = 1000.0;
-  }
+  const std::filesystem::path folder = SharedDataFolder(dataset.name);
+  if (const std::string missing = MissingSharedData(folder); !missing.empty())
+    GTEST_SKIP() << missing;
+  const LoadOptions load = SharedDataLoadOptions(folder, dataset.depth_images);
   IcpOptions options;  // as a search evaluation (SearchIcpOptions)
   options.max_correspondence_distance = 3.0 * dataset.voxel;
   options.max_iterations = 60;

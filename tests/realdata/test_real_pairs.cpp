@@ -14,6 +14,7 @@
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/evaluation.hpp"
+#include "shared_data.hpp"
 
 namespace boicp {
 namespace {
@@ -32,16 +33,10 @@ class RealPairs : public ::testing::TestWithParam<DatasetCase> {};
 
 TEST_P(RealPairs, AutomaticSettingsRecoverArbitraryHeadings) {
   const DatasetCase& dataset = GetParam();
-  const std::filesystem::path folder = std::filesystem::path(BOICP_SHARED_DATA_DIR) / dataset.name;
-  if (!std::filesystem::exists(folder / "pairs.csv")) {
-    GTEST_SKIP() << "real data not found at " << folder.string()
-                 << " (../shared/data beside the project root); skipping";
-  }
-  LoadOptions load;
-  if (dataset.depth_images) {
-    load.depth.intrinsics = ReadIntrinsicsFile((folder / "camera-intrinsics.txt").string());
-    load.depth.depth_scale = 1000.0;
-  }
+  const std::filesystem::path folder = SharedDataFolder(dataset.name);
+  if (const std::string missing = MissingSharedData(folder); !missing.empty())
+    GTEST_SKIP() << missing;
+  const LoadOptions load = SharedDataLoadOptions(folder, dataset.depth_images);
   BoIcpConfig config = PresetConfig("C");
   config.threads = 1;
 
