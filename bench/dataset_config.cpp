@@ -37,7 +37,11 @@ BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input)
 }
 
 BoIcpConfig DatasetTableConfig(const std::string& preset, const MethodInput& input) {
-  return PresetForDataset(preset, input, false);
+  BoIcpConfig config = PresetForDataset(preset, input, false);
+  // The baselines run no search evaluations, so PreparePair estimates no
+  // target normals for them.
+  config.icp_objective = IcpObjective::kPointToPoint;
+  return config;
 }
 
 }  // namespace boicp::bench
