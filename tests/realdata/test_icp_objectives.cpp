@@ -17,8 +17,7 @@
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/evaluation.hpp"
 #include "boicp/registration/icp.hpp"
-#include "boicp/registration/preprocess.hpp"
-#include "boicp/registration/surface_normals.hpp"
+#include "boicp/registration/refinement.hpp"
 #include "shared_data.hpp"
 
 namespace boicp {
@@ -50,21 +49,22 @@ TEST_P(IcpObjectives, PointToPlaneReachesTheSameBasinsInFewerIterations) {
   if (const std::string missing = MissingSharedData(folder); !missing.empty())
     GTEST_SKIP() << missing;
   const LoadOptions load = SharedDataLoadOptions(folder, dataset.depth_images);
-  IcpOptions options;  // as a search evaluation (SearchIcpOptions)
-  options.max_correspondence_distance = 3.0 * dataset.voxel;
-  options.max_iterations = 60;
-  options.convergence_translation = 1e-2 * dataset.voxel;
-  options.convergence_rotation = 1e-3;
+  BoIcpConfig config = PresetConfig("C");
+  config.voxel = dataset.voxel;
+  config.threads = 2;
+  const IcpOptions options = SearchIcpOptions(config);
 
   std::mt19937_64 rng(20261202);
   int point_reached = 0, plane_reached = 0, plane_missed_where_point_reached = 0;
   int point_iterations = 0, plane_iterations = 0;
   const std::vector<ReferencePair> pairs = ReadPairsCsv((folder / "pairs.csv").string());
   for (const ReferencePair& pair : pairs) {
-    const Points source = VoxelDownsample(LoadPointCloud(pair.source, load).points, dataset.voxel);
-    const NearestNeighborIndex target(
-        VoxelDownsample(LoadPointCloud(pair.target, load).points, dataset.voxel));
-    const Points normals = EstimateSurfaceNormals(target, 3.0 * dataset.voxel, 2);
+    // The search clouds and target normals as RegisterPair prepares them.
+    const PreparedPair prepared = PreparePair(LoadPointCloud(pair.source, load).points,
+                                              LoadPointCloud(pair.target, load).points, config);
+    const Points& source = prepared.search_source;
+    const NearestNeighborIndex& target = prepared.search_target;
+    const Points& normals = prepared.search_target_normals;
     const Transform start = PerturbedStart(pair.T_target_source, dataset.voxel, rng);
     const IcpResult point = AlignPointToPoint(source, target, start, options);
     const IcpResult plane = AlignPointToPlane(source, target, normals, start, options);
