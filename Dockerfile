@@ -24,7 +24,7 @@ RUN bash deploy/install-deps.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
 # .ci/run builds with -j2 on the 2-core CI machine; raise it on a bigger builder.
 ARG BUILD_JOBS=2
-RUN cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DBOICP_WARNINGS_AS_ERRORS=ON \
+RUN cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DBOICP_WARNINGS_AS_ERRORS=ON -DCMAKE_UNITY_BUILD=ON \
  && cmake --build build -j"${BUILD_JOBS}" --target boicpd boicp
 
 FROM scratch AS prebuilt

@@ -15,6 +15,7 @@
 
 #include "boicp/util/atomic_file.hpp"
 #include "mapping/octree_file.hpp"
+#include "util/percentile.hpp"
 
 namespace boicp {
 namespace {
@@ -57,12 +58,6 @@ Rgb Turbo(double t) {
     return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255));
   };
   return {byte(r), byte(g), byte(b)};
-}
-
-double Percentile(std::vector<double> values, double q) {
-  const size_t k = static_cast<size_t>(q * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
 }
 
 class Canvas {

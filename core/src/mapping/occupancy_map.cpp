@@ -21,7 +21,7 @@ using octomap::KeySet;
 using octomap::OcTreeKey;
 using octomap::point3d;
 
-void Require(bool ok, const std::string& message) {
+void RequireValidMapSettings(bool ok, const std::string& message) {
   if (!ok) throw InputError("map settings: " + message);
 }
 
@@ -283,14 +283,15 @@ struct OccupancyMap::Impl {
 };
 
 void ValidateOccupancySettings(const OccupancySettings& s) {
-  Require(std::isfinite(s.resolution) && s.resolution >= 0.001 && s.resolution <= 100.0,
-          "resolution must be between 0.001 and 100 m");
-  Require(std::isfinite(s.max_range) && s.max_range >= 0.0,
-          "max_range must be >= 0 (0 = no limit)");
-  Require(s.prob_hit > 0.5 && s.prob_hit < 1.0, "prob_hit must be in (0.5, 1)");
-  Require(s.prob_miss > 0.0 && s.prob_miss < 0.5, "prob_miss must be in (0, 0.5)");
-  Require(s.clamp_min > 0.0 && s.clamp_min < s.clamp_max && s.clamp_max < 1.0,
-          "clamping thresholds must satisfy 0 < clamp_min < clamp_max < 1");
+  RequireValidMapSettings(
+      std::isfinite(s.resolution) && s.resolution >= 0.001 && s.resolution <= 100.0,
+      "resolution must be between 0.001 and 100 m");
+  RequireValidMapSettings(std::isfinite(s.max_range) && s.max_range >= 0.0,
+                          "max_range must be >= 0 (0 = no limit)");
+  RequireValidMapSettings(s.prob_hit > 0.5 && s.prob_hit < 1.0, "prob_hit must be in (0.5, 1)");
+  RequireValidMapSettings(s.prob_miss > 0.0 && s.prob_miss < 0.5, "prob_miss must be in (0, 0.5)");
+  RequireValidMapSettings(s.clamp_min > 0.0 && s.clamp_min < s.clamp_max && s.clamp_max < 1.0,
+                          "clamping thresholds must satisfy 0 < clamp_min < clamp_max < 1");
 }
 
 OccupancyMap::OccupancyMap(const OccupancySettings& settings) {

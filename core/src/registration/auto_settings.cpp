@@ -9,6 +9,7 @@
 #include <open3d/geometry/PointCloud.h>
 
 #include "boicp/registration/preprocess.hpp"
+#include "util/percentile.hpp"
 
 namespace boicp {
 namespace {
@@ -53,12 +54,6 @@ constexpr int kPlaneTrials = 200;
 // those of the whole cloud by far less than the rules' precision.
 constexpr size_t kMeasuredPoints = 20000;
 constexpr size_t kSpacingQueries = 1000;
-
-double Percentile(std::vector<double> values, double q) {
-  const size_t k = static_cast<size_t>(q * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
-}
 
 bool SeesAllAround(const Points& points) {
   // A cone of view (a camera's, or an object seen from one side) has its

@@ -14,32 +14,37 @@
 namespace boicp {
 namespace {
 
-void Require(bool ok, const std::string& message) {
+void RequireValidOptions(bool ok, const std::string& message) {
   if (!ok) throw InputError("BayesOptOptions: " + message);
 }
 
 void ValidateOptions(const BayesOptOptions& o, const std::vector<bool>& periodic) {
-  Require(!periodic.empty(), "the search space needs at least one dimension (periodic is empty)");
-  Require(o.initial_samples >= 1,
-          "initial_samples must be >= 1, got " + std::to_string(o.initial_samples));
-  Require(o.iterations >= 0, "iterations must be >= 0, got " + std::to_string(o.iterations));
-  Require(o.refit_every >= 1, "refit_every must be >= 1, got " + std::to_string(o.refit_every));
-  Require(o.batch_size >= 1, "batch_size must be >= 1, got " + std::to_string(o.batch_size));
-  Require(o.threads >= 1, "threads must be >= 1, got " + std::to_string(o.threads));
-  Require(o.confidence_candidates >= 1,
-          "confidence_candidates must be >= 1, got " + std::to_string(o.confidence_candidates));
+  RequireValidOptions(!periodic.empty(),
+                      "the search space needs at least one dimension (periodic is empty)");
+  RequireValidOptions(o.initial_samples >= 1,
+                      "initial_samples must be >= 1, got " + std::to_string(o.initial_samples));
+  RequireValidOptions(o.iterations >= 0,
+                      "iterations must be >= 0, got " + std::to_string(o.iterations));
+  RequireValidOptions(o.refit_every >= 1,
+                      "refit_every must be >= 1, got " + std::to_string(o.refit_every));
+  RequireValidOptions(o.batch_size >= 1,
+                      "batch_size must be >= 1, got " + std::to_string(o.batch_size));
+  RequireValidOptions(o.threads >= 1, "threads must be >= 1, got " + std::to_string(o.threads));
+  RequireValidOptions(o.confidence_candidates >= 1, "confidence_candidates must be >= 1, got " +
+                                                        std::to_string(o.confidence_candidates));
   // Checked here too so a bad config fails before the first (costly) evaluation.
   const AcquisitionOptions& a = o.acquisition;
-  Require(a.random_candidates >= 1 && a.local_starts >= 0 && a.local_max_evaluations >= 1 &&
-              std::isfinite(a.xi),
-          "acquisition needs random_candidates >= 1, local_starts >= 0, "
-          "local_max_evaluations >= 1 and a finite xi");
+  RequireValidOptions(a.random_candidates >= 1 && a.local_starts >= 0 &&
+                          a.local_max_evaluations >= 1 && std::isfinite(a.xi),
+                      "acquisition needs random_candidates >= 1, local_starts >= 0, "
+                      "local_max_evaluations >= 1 and a finite xi");
   const GpFitOptions& g = o.fit;
-  Require(g.restarts >= 0 && g.max_evaluations >= 1 && 0 < g.min_length_scale &&
-              g.min_length_scale <= g.max_length_scale && 0 < g.min_signal_variance &&
-              g.min_signal_variance <= g.max_signal_variance && 0 < g.min_noise_variance &&
-              g.min_noise_variance <= g.max_noise_variance,
-          "fit needs restarts >= 0, max_evaluations >= 1 and 0 < min <= max for every bound");
+  RequireValidOptions(
+      g.restarts >= 0 && g.max_evaluations >= 1 && 0 < g.min_length_scale &&
+          g.min_length_scale <= g.max_length_scale && 0 < g.min_signal_variance &&
+          g.min_signal_variance <= g.max_signal_variance && 0 < g.min_noise_variance &&
+          g.min_noise_variance <= g.max_noise_variance,
+      "fit needs restarts >= 0, max_evaluations >= 1 and 0 < min <= max for every bound");
 }
 
 // initial_points (clamped into the box) followed by Latin-hypercube rows up to

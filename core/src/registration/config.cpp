@@ -93,7 +93,7 @@ BoIcpConfig PresetConfig(const std::string& name) {
 
 namespace {
 
-void Require(bool ok, const std::string& message) {
+void RequireValidConfig(bool ok, const std::string& message) {
   if (!ok) throw InputError("invalid config: " + message);
 }
 
@@ -104,41 +104,47 @@ bool FiniteNonNegative(const Eigen::Vector3d& v) {
 }  // namespace
 
 void ValidateConfig(const BoIcpConfig& c) {
-  Require(c.random_samples >= 1, "random samples (N_r) must be at least 1");
-  Require(c.iterations >= 0, "iterations (N) must not be negative");
-  Require(std::isfinite(c.voxel) && c.voxel > 0.0, "voxel must be a positive number of metres");
-  Require(std::isfinite(c.retry_voxel) && c.retry_voxel >= 0.0,
-          "retry voxel must be >= 0 metres (0 = the search voxel)");
-  Require(FiniteNonNegative(c.rotation_bounds),
-          "rotation bounds must be finite and non-negative (radians)");
-  Require(FiniteNonNegative(c.translation_bounds),
-          "translation bounds must be finite and non-negative (metres)");
-  Require(c.rotation_bounds.maxCoeff() > 0.0 || c.translation_bounds.maxCoeff() > 0.0,
-          "rotation and translation bounds are all zero: nothing to search");
+  RequireValidConfig(c.random_samples >= 1, "random samples (N_r) must be at least 1");
+  RequireValidConfig(c.iterations >= 0, "iterations (N) must not be negative");
+  RequireValidConfig(std::isfinite(c.voxel) && c.voxel > 0.0,
+                     "voxel must be a positive number of metres");
+  RequireValidConfig(std::isfinite(c.retry_voxel) && c.retry_voxel >= 0.0,
+                     "retry voxel must be >= 0 metres (0 = the search voxel)");
+  RequireValidConfig(FiniteNonNegative(c.rotation_bounds),
+                     "rotation bounds must be finite and non-negative (radians)");
+  RequireValidConfig(FiniteNonNegative(c.translation_bounds),
+                     "translation bounds must be finite and non-negative (metres)");
+  RequireValidConfig(c.rotation_bounds.maxCoeff() > 0.0 || c.translation_bounds.maxCoeff() > 0.0,
+                     "rotation and translation bounds are all zero: nothing to search");
   const Eigen::Vector3d rotation = SnapRotationBounds(c.rotation_bounds);
-  Require(rotation[0] <= M_PI && rotation[2] <= M_PI, "roll and yaw bounds must not exceed pi");
-  Require(rotation[1] <= M_PI / 2,
-          "pitch bound must not exceed pi/2 (larger pitches repeat rotations already covered)");
-  Require(std::isfinite(c.max_correspondence_distance) && c.max_correspondence_distance >= 0.0,
-          "max correspondence distance must be >= 0 (0 = 3 x voxel)");
-  Require(std::isfinite(c.objective_truncation) && c.objective_truncation >= 0.0,
-          "objective truncation must be >= 0 (0 = 1.5 x voxel)");
-  Require(c.icp_max_iterations >= 1, "ICP iterations must be at least 1");
-  Require(c.finish_icp_iterations >= 1, "ICP finishing iterations must be at least 1");
-  Require(c.refine_candidates >= 1, "refine candidates must be at least 1");
-  Require(c.refine_max_iterations >= 1, "refinement ICP iterations must be at least 1");
-  Require(std::isfinite(c.refine_voxel) && c.refine_voxel >= 0.0 && c.refine_voxel <= c.voxel,
-          "refine voxel must be between 0 (auto) and the search voxel");
-  Require(std::isfinite(c.inlier_distance) && c.inlier_distance >= 0.0,
-          "inlier distance must be >= 0 (0 = auto)");
-  Require(std::isfinite(c.min_range) && std::isfinite(c.max_range) && c.min_range >= 0.0 &&
-              c.max_range >= 0.0 && (c.max_range == 0.0 || c.max_range > c.min_range),
-          "ranges must satisfy 0 <= min_range < max_range (max_range 0 = no limit)");
-  Require(c.threads >= 1, "threads must be at least 1");
+  RequireValidConfig(rotation[0] <= M_PI && rotation[2] <= M_PI,
+                     "roll and yaw bounds must not exceed pi");
+  RequireValidConfig(
+      rotation[1] <= M_PI / 2,
+      "pitch bound must not exceed pi/2 (larger pitches repeat rotations already covered)");
+  RequireValidConfig(
+      std::isfinite(c.max_correspondence_distance) && c.max_correspondence_distance >= 0.0,
+      "max correspondence distance must be >= 0 (0 = 3 x voxel)");
+  RequireValidConfig(std::isfinite(c.objective_truncation) && c.objective_truncation >= 0.0,
+                     "objective truncation must be >= 0 (0 = 1.5 x voxel)");
+  RequireValidConfig(c.icp_max_iterations >= 1, "ICP iterations must be at least 1");
+  RequireValidConfig(c.finish_icp_iterations >= 1, "ICP finishing iterations must be at least 1");
+  RequireValidConfig(c.refine_candidates >= 1, "refine candidates must be at least 1");
+  RequireValidConfig(c.refine_max_iterations >= 1, "refinement ICP iterations must be at least 1");
+  RequireValidConfig(
+      std::isfinite(c.refine_voxel) && c.refine_voxel >= 0.0 && c.refine_voxel <= c.voxel,
+      "refine voxel must be between 0 (auto) and the search voxel");
+  RequireValidConfig(std::isfinite(c.inlier_distance) && c.inlier_distance >= 0.0,
+                     "inlier distance must be >= 0 (0 = auto)");
+  RequireValidConfig(std::isfinite(c.min_range) && std::isfinite(c.max_range) &&
+                         c.min_range >= 0.0 && c.max_range >= 0.0 &&
+                         (c.max_range == 0.0 || c.max_range > c.min_range),
+                     "ranges must satisfy 0 <= min_range < max_range (max_range 0 = no limit)");
+  RequireValidConfig(c.threads >= 1, "threads must be at least 1");
   for (const std::string& field : c.automatic) {
-    Require(std::find(kAutoRegistrationFields.begin(), kAutoRegistrationFields.end(), field) !=
-                kAutoRegistrationFields.end(),
-            "'" + field + "' is not a setting that can be chosen automatically");
+    RequireValidConfig(std::find(kAutoRegistrationFields.begin(), kAutoRegistrationFields.end(),
+                                 field) != kAutoRegistrationFields.end(),
+                       "'" + field + "' is not a setting that can be chosen automatically");
   }
 }
 
