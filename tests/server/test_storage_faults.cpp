@@ -186,8 +186,8 @@ TEST_F(StorageFaults, FinalStateThatCannotBeStoredIsNotPublished) {
   InjectJobUpdateFault("NEW.state = 3");  // SUCCEEDED
   const std::string job_id = client.Submit(QuickBatch(ids)).job_id();
   std::atomic<bool> watcher_saw_success{false};
-  std::thread watcher([&] {
-    auto own = Client();
+  // Connected here: the main thread replaces daemon_ below.
+  std::thread watcher([&, own = Client()]() mutable {
     try {
       own.Watch(job_id, [&](const v1::JobEvent& e) {
         if (e.job().state() == v1::JOB_STATE_SUCCEEDED) watcher_saw_success = true;
