@@ -6,16 +6,10 @@
 # .ci/run but builds only the two binaries: .ci/run runs the tests on its host
 # build, then runs this image with tests/deploy/test_image.sh. (podman keeps the
 # HEALTHCHECK only with `podman build --format docker`.)
-# The runtime stage holds only the runtime libraries and the two binaries.
+# The base stage holds only the runtime libraries, the user and the container
+# settings; the last two stages add the two binaries to it.
 # tests/deploy/check_deploy.py (ctest deploy_*) keeps this file in step with
 # deploy/install-deps.sh, .ci/run and CMake.
-
-# The runtime stage takes the binaries from the `binaries` stage: by default
-# the build stage below; with --build-arg BINARIES=prebuilt, build/bin/boicpd
-# and build/bin/boicp of the build context, which must come from a build on
-# Debian bookworm with deploy/install-deps.sh (tests/deploy/test_image.sh
-# --prebuilt gives it the binaries .ci/run has just built and tested).
-ARG BINARIES=build
 
 FROM debian:bookworm AS build
 WORKDIR /src
@@ -27,12 +21,7 @@ ARG BUILD_JOBS=2
 RUN cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DBOICP_WARNINGS_AS_ERRORS=ON -DCMAKE_UNITY_BUILD=ON \
  && cmake --build build -j"${BUILD_JOBS}" --target boicpd boicp
 
-FROM scratch AS prebuilt
-COPY build/bin/boicpd build/bin/boicp /src/build/bin/
-
-FROM ${BINARIES} AS binaries
-
-FROM debian:bookworm-slim AS runtime
+FROM debian:bookworm-slim AS base
 ARG VERSION=0.1.0
 LABEL org.opencontainers.image.title="boicp" \
       org.opencontainers.image.description="BO-ICP map building: boicpd daemon, boicp client" \
@@ -41,7 +30,6 @@ LABEL org.opencontainers.image.title="boicp" \
       org.opencontainers.image.licenses="NOASSERTION"
 COPY deploy/install-deps.sh /tmp/install-deps.sh
 RUN bash /tmp/install-deps.sh --runtime && rm -rf /var/lib/apt/lists/* /tmp/install-deps.sh
-COPY --from=binaries /src/build/bin/boicpd /src/build/bin/boicp /usr/local/bin/
 # A fixed numeric uid so Kubernetes' runAsNonRoot can check it and volumes can be chowned to it.
 RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/boicpd \
       --shell /usr/sbin/nologin boicp \
@@ -60,3 +48,16 @@ HEALTHCHECK --interval=30s --timeout=5s --start-period=30s --retries=3 CMD ["boi
 # boicpd blocks SIGTERM/SIGINT and waits for them, so as PID 1 it still drains on `docker stop`.
 STOPSIGNAL SIGTERM
 CMD ["boicpd"]
+
+# The default target, `runtime`, takes the two binaries from the build stage.
+# `--target prebuilt` takes build/bin/boicpd and build/bin/boicp of the build
+# context instead and skips the build stage; they must come from a build on
+# Debian bookworm with deploy/install-deps.sh (tests/deploy/test_image.sh
+# --prebuilt gives it the binaries .ci/run has just built and tested). Both
+# are stages of their own, not one chosen by a build argument, because
+# podman's buildah skips a stage named only through an argument's default.
+FROM base AS prebuilt
+COPY build/bin/boicpd build/bin/boicp /usr/local/bin/
+
+FROM base AS runtime
+COPY --from=build /src/build/bin/boicpd /src/build/bin/boicp /usr/local/bin/

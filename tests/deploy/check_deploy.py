@@ -119,20 +119,18 @@ def check_dockerfile(args):
 
     stages = stage_names(instructions)
     debian = [i for i, (base, _) in enumerate(stages) if base.startswith("debian:bookworm")]
-    if len(debian) != 2 or stages[debian[0]][1] != "build" or debian[1] != len(stages) - 1:
-        problems.append(
-            f"Dockerfile: want a build and a last (runtime) stage FROM debian:bookworm*, got {stages}"
-        )
+    want = [("debian:bookworm", "build"), ("debian:bookworm-slim", "base"), ("base", "prebuilt"),
+            ("base", "runtime")]
+    if stages != want:
+        problems.append(f"Dockerfile: want the stages {want}, got {stages}")
         return problems
-    build, runtime = debian
-    problems += check_binaries_choice(read(os.path.join(root, "Dockerfile")), stages)
-
+    build, base = debian
     runs = [(stage, a) for stage, k, a in instructions if k == "RUN"]
-    problems += check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_packages)
+    problems += check_apt_and_deps_script(runs, build, base, build_packages, runtime_packages)
     problems += check_build_flags(root, runs)
     problems += check_build_targets(args, runs, build)
-    problems += check_copied_binaries(args, instructions, stages, runtime)
-    problems += check_runtime_stage(instructions, known_env, root, runtime)
+    problems += check_copied_binaries(args, instructions, stages)
+    problems += check_runtime_stage(instructions, known_env, root, base)
     return problems
 
 
@@ -144,20 +142,6 @@ def stage_names(instructions):
             words = argument.split()
             stages.append((words[0], words[2] if len(words) > 2 and words[1].upper() == "AS" else ""))
     return stages
-
-
-def check_binaries_choice(text, stages):
-    """The runtime copies from a `binaries` stage that is the build stage unless
-    BINARIES=prebuilt picks the binaries of the build context (a CI's host build)."""
-    problems = []
-    default = re.search(r"^ARG BINARIES=(\S+)", text, re.M)
-    if not default or default.group(1) != "build":
-        problems.append("Dockerfile: want `ARG BINARIES=build` before the first FROM")
-    if ("scratch", "prebuilt") not in stages:
-        problems.append("Dockerfile: want a `FROM scratch AS prebuilt` stage")
-    if ("${BINARIES}", "binaries") not in stages:
-        problems.append("Dockerfile: want a `FROM ${BINARIES} AS binaries` stage")
-    return problems
 
 
 def check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_packages):
@@ -178,7 +162,7 @@ def check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_pack
     if used_deps_script.get(build) != []:
         problems.append("Dockerfile: the build stage must run deploy/install-deps.sh with no flags")
     if used_deps_script.get(runtime) != ["--runtime"]:
-        problems.append("Dockerfile: the runtime stage must run deploy/install-deps.sh --runtime")
+        problems.append("Dockerfile: the base stage must run deploy/install-deps.sh --runtime")
     return problems
 
 
@@ -219,21 +203,25 @@ def check_build_targets(args, runs, build):
     return problems
 
 
-def check_copied_binaries(args, instructions, stages, runtime):
-    """The runtime copies exactly the binaries CMake builds, from where CMake puts
-    them, and the prebuilt stage takes the same files from the build context."""
+def check_copied_binaries(args, instructions, stages):
+    """The default target copies exactly the binaries CMake builds, from where CMake
+    puts them in the build stage; `prebuilt` takes the same files from the build context."""
     built = {}
     for path in (args.boicpd, args.boicp):
         built[os.path.basename(path)] = os.path.relpath(path, args.build_dir)
-    prebuilt = next(i for i, stage in enumerate(stages) if stage == ("scratch", "prebuilt"))
+    prebuilt, runtime = stages.index(("base", "prebuilt")), stages.index(("base", "runtime"))
     copied, context = {}, {}
     for stage, keyword, argument in instructions:
         sources = [w for w in argument.split() if not w.startswith("--")][:-1]
-        if keyword == "COPY" and stage == runtime and "--from=binaries" in argument:
+        if keyword == "COPY" and stage == runtime and "--from=build" in argument.split():
             copied.update((os.path.basename(source), source) for source in sources)
         if keyword == "COPY" and stage == prebuilt:
             context.update((os.path.basename(source), source) for source in sources)
     problems = []
+    for stage in (prebuilt, runtime):
+        if [k for s, k, _ in instructions if s == stage and k != "FROM"] != ["COPY"]:
+            problems.append(f"Dockerfile: the {stages[stage][1]} stage must only copy the binaries"
+                            " (the rest belongs in base, which both targets share)")
     if set(copied) != set(built):
         problems.append(f"Dockerfile: copies {sorted(copied)}, CMake builds {sorted(built)}")
     for name, source in copied.items():
@@ -252,10 +240,10 @@ def check_runtime_stage(instructions, known_env, root, runtime_stage):
     problems = []
     health = by_keyword.get("HEALTHCHECK", [])
     if len(health) != 1 or exec_form(health[0].partition("CMD")[2])[:2] != ["boicp", "health"]:
-        problems.append("Dockerfile: the runtime stage needs one HEALTHCHECK CMD boicp health")
+        problems.append("Dockerfile: the base stage needs one HEALTHCHECK CMD boicp health")
     users = by_keyword.get("USER", [])
     if not users or users[-1].split(":")[0] in ("root", "0"):
-        problems.append("Dockerfile: the runtime stage must end with a non-root USER")
+        problems.append("Dockerfile: the base stage must end with a non-root USER")
     env = dockerfile_env(by_keyword.get("ENV", []))
     problems += [
         f"Dockerfile: ENV {name} is not a boicpd variable"

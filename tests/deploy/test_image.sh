@@ -17,8 +17,8 @@
 # with a free loopback port, and are removed on exit, as are the volumes.
 # Usage: tests/deploy/test_image.sh [--prebuilt] BIN_DIR
 #   BIN_DIR      the host build's binaries (boicp is the host client), e.g. build/bin
-#   --prebuilt   the image takes BIN_DIR's boicpd and boicp (--build-arg
-#                BINARIES=prebuilt) instead of compiling them again: for .ci/run,
+#   --prebuilt   the image takes BIN_DIR's boicpd and boicp (--target
+#                prebuilt) instead of compiling them again: for .ci/run,
 #                whose host build on the same Debian release has just been tested
 #   BOICP_SHARED_DIR   default ../shared beside the repository
 #   BOICP_IMAGE_SKIP_COMPOSE=1  skip the compose part
@@ -106,12 +106,12 @@ build_flags=(-t "$image" -f "$root/Dockerfile")
 [ "$engine" = podman ] && build_flags+=(--format docker)
 context=$root
 if [ -n "$prebuilt" ]; then
-  # Only what the prebuilt and runtime stages copy: the compile stage is unused and skipped.
+  # Only what the base and prebuilt stages copy: the build stage is unused and skipped.
   context=$tmp/context
   mkdir -p "$context/deploy" "$context/build/bin"
   cp "$root/deploy/install-deps.sh" "$context/deploy/"
   cp "$bin/boicpd" "$bin/boicp" "$context/build/bin/"
-  build_flags+=(--build-arg BINARIES=prebuilt)
+  build_flags+=(--target prebuilt)
 fi
 start=$(date +%s)
 log "building $image${prebuilt:+ around the binaries of $bin} (log $tmp/build.log)"
