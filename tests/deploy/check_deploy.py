@@ -118,13 +118,12 @@ def check_dockerfile(args):
     known_env = {env for env, _ in env_options.values()}
 
     stages = stage_names(instructions)
-    debian = [i for i, (base, _) in enumerate(stages) if base.startswith("debian:bookworm")]
     want = [("debian:bookworm", "build"), ("debian:bookworm-slim", "base"), ("base", "prebuilt"),
             ("base", "runtime")]
     if stages != want:
         problems.append(f"Dockerfile: want the stages {want}, got {stages}")
         return problems
-    build, base = debian
+    build, base = 0, 1
     runs = [(stage, a) for stage, k, a in instructions if k == "RUN"]
     problems += check_apt_and_deps_script(runs, build, base, build_packages, runtime_packages)
     problems += check_build_flags(root, runs)
