@@ -129,7 +129,7 @@ def check_dockerfile(args):
     problems += check_build_flags(root, runs)
     problems += check_build_targets(args, runs, build)
     problems += check_copied_binaries(args, instructions, stages)
-    problems += check_runtime_stage(instructions, known_env, root, base)
+    problems += check_base_stage(instructions, known_env, root, base)
     return problems
 
 
@@ -143,7 +143,7 @@ def stage_names(instructions):
     return stages
 
 
-def check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_packages):
+def check_apt_and_deps_script(runs, build, base, build_packages, runtime_packages):
     problems, used_deps_script = [], {}
     allowed = set(build_packages) | set(runtime_packages)
     for stage, argument in runs:
@@ -160,7 +160,7 @@ def check_apt_and_deps_script(runs, build, runtime, build_packages, runtime_pack
                 ]
     if used_deps_script.get(build) != []:
         problems.append("Dockerfile: the build stage must run deploy/install-deps.sh with no flags")
-    if used_deps_script.get(runtime) != ["--runtime"]:
+    if used_deps_script.get(base) != ["--runtime"]:
         problems.append("Dockerfile: the base stage must run deploy/install-deps.sh --runtime")
     return problems
 
@@ -231,8 +231,8 @@ def check_copied_binaries(args, instructions, stages):
     return problems
 
 
-def check_runtime_stage(instructions, known_env, root, runtime_stage):
-    runtime = [(k, a) for stage, k, a in instructions if stage == runtime_stage]
+def check_base_stage(instructions, known_env, root, base):
+    runtime = [(k, a) for stage, k, a in instructions if stage == base]
     by_keyword = {}
     for keyword, argument in runtime:
         by_keyword.setdefault(keyword, []).append(argument)
