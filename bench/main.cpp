@@ -10,7 +10,7 @@
 #include "bench_options.hpp"
 #include "bench_pairs.hpp"
 #include "bench_run.hpp"
-#include "boicp/util/openmp_policy.hpp"
+#include "openmp_policy.hpp"
 #include "thread_budget.hpp"
 
 namespace {

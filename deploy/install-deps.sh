@@ -23,7 +23,7 @@ PACKAGES=(
 # The shared libraries boicpd and boicp link directly (objdump -p NEEDED, then
 # dpkg -S); apt pulls in their own dependencies.
 RUNTIME_PACKAGES=(
-  libc6 libgcc-s1 libstdc++6 libgomp1
+  libc6 libgcc-s1 libstdc++6
   libopen3d0.16 liboctomap1.9 libnlopt0 libfmt9 libspdlog1.10 libsqlite3-0 libssl3
   libgrpc++1.51 libgrpc29 libprotobuf32 libabsl20220623 libtbb12
 )

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include <omp.h>
 #include <spdlog/spdlog.h>
 
 #include "boicp/rpc/proto_convert.hpp"
@@ -22,11 +21,7 @@ constexpr int kMaxUnendedRuns = 2;
 JobManager::JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
                        const ManagerOptions& options)
     : store_(store), data_dir_(data_dir), events_(events), options_(options) {
-  const int omp_threads = options_.registration_threads;
-  // OpenMP regions inside the engine and Open3D take this thread's limit, so
-  // workers x registration threads is the whole registration load.
-  pool_ = std::make_unique<ThreadPool>(options_.workers,
-                                       [omp_threads] { omp_set_num_threads(omp_threads); });
+  pool_ = std::make_unique<ThreadPool>(options_.workers);
   context_ = std::make_unique<RunnerContext>(RunnerContext{
       store_, data_dir_, *pool_, events_, options_.registration_threads, options_.workers});
 }

@@ -11,7 +11,6 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
-#include "boicp/util/openmp_policy.hpp"
 #include "daemon.hpp"
 #include "daemon_options.hpp"
 
@@ -28,7 +27,6 @@ sigset_t ShutdownSignals() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  boicp::RestartWithPassiveOpenMpWait(argv);
   CLI::App app{"boicpd: BO-ICP map-building daemon (gRPC)"};
   app.set_version_flag("--version", "boicpd " BOICP_VERSION);
   boicp::server::DaemonOptions options;

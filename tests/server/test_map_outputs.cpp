@@ -3,7 +3,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
+#include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
@@ -97,7 +100,12 @@ TEST_F(MapOutputs, FuseScansWritesEveryOutputAndMarksScannedSurfaces) {
   settings.occupancy.max_range = 20.0;
   MapOutputPaths out{Path("map.bt"), Path("map.ot"), Path("t.tum"), Path("t.kitti"),
                      Path("map.ply")};
+  // OctoMap's own .bt writer prints " done."; fusion stays quiet.
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
   const FusionSummary summary = FuseScans(scans, poses, settings, out);
+  EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
   EXPECT_GT(summary.occupied_leaves, 1000u);
   EXPECT_GT(summary.cloud_points, 1000u);
   for (const std::string& file :
@@ -123,7 +131,13 @@ TEST_F(MapOutputs, FuseScansWritesEveryOutputAndMarksScannedSurfaces) {
 
   std::unique_ptr<octomap::AbstractOcTree> full(octomap::AbstractOcTree::read(out.octomap_ot));
   ASSERT_TRUE(full);
-  EXPECT_NE(dynamic_cast<octomap::OcTree*>(full.get()), nullptr);
+  auto* full_tree = dynamic_cast<octomap::OcTree*>(full.get());
+  ASSERT_NE(full_tree, nullptr);
+  // The .bt holds the bytes OctoMap's own writer gives for the same tree.
+  std::ostringstream octomap_bt;
+  ASSERT_TRUE(full_tree->writeBinary(octomap_bt));
+  std::ifstream written(out.octomap_bt, std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(written), {}), octomap_bt.str());
 }
 
 TEST_F(MapOutputs, FuseScansStopsWhenAsked) {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include <open3d/geometry/KDTreeSearchParam.h>
-#include <open3d/geometry/PointCloud.h>
 #include <Eigen/Eigenvalues>
+
+#include "boicp/registration/surface_normals.hpp"
 
 namespace boicp {
 namespace {
@@ -36,12 +36,9 @@ std::pair<Eigen::Vector3d, std::string> PriorUp(const std::vector<Transform>& po
   return {Eigen::Vector3d::UnitZ(), "the map's z"};
 }
 
+// A cell's neighbours within three cells span its surface patch.
 std::vector<Eigen::Vector3d> CellNormals(const Points& centres, double resolution) {
-  open3d::geometry::PointCloud cloud;
-  cloud.points_ = centres;
-  cloud.EstimateNormals(open3d::geometry::KDTreeSearchParamHybrid(3.0 * resolution, 30),
-                        /*fast_normal_computation=*/false);
-  return cloud.normals_;
+  return EstimateSurfaceNormals(NearestNeighborIndex(centres), 3.0 * resolution, /*threads=*/1);
 }
 
 // Area-weighted fraction of the normals within the tolerance of `axis`
@@ -91,8 +88,13 @@ UpDirection DetectUp(const Points& centres, const std::vector<double>& sizes, do
   }
 
   const std::vector<Eigen::Vector3d> normals = CellNormals(centres, resolution);
+  // A cell weighs its area; one without a surface normal (too few
+  // neighbours, or on a line) weighs nothing.
   std::vector<double> weights(normals.size(), 1.0);
-  for (size_t i = 0; i < normals.size() && i < sizes.size(); ++i) weights[i] = sizes[i] * sizes[i];
+  for (size_t i = 0; i < normals.size(); ++i) {
+    if (i < sizes.size()) weights[i] = sizes[i] * sizes[i];
+    if (normals[i].isZero()) weights[i] = 0.0;
+  }
   const double cos_tolerance = std::cos(options.normal_tolerance);
   const double cos_prior = std::cos(options.max_prior_angle);
   const size_t candidate_stride = std::max<size_t>(1, normals.size() / kMaxCandidates);

@@ -12,6 +12,7 @@
 #include <octomap/OcTree.h>
 
 #include "boicp/util/parallel_for.hpp"
+#include "mapping/octree_file.hpp"
 #include "stoppable_output.hpp"
 
 namespace boicp {
@@ -362,8 +363,8 @@ size_t OccupancyMap::OccupiedLeaves() {
 
 namespace {
 
-// Writes through OctoMap's stream overloads, because its file-name overloads
-// print progress to stdout, which is the daemon's log.
+// Writes through streams, because OctoMap's file-name overloads print
+// progress to stdout, which is the daemon's log.
 void WriteTree(const std::string& path, const std::string& kind, const MapStopRequest& stop,
                const std::function<bool(std::ostream&)>& write) {
   std::filebuf file;
@@ -388,7 +389,8 @@ void OccupancyMap::WriteFull(const std::string& path, const MapStopRequest& stop
 
 void OccupancyMap::WriteBinary(const std::string& path, const MapStopRequest& stop) {
   impl_->UpdateInner();
-  WriteTree(path, ".bt", stop, [&](std::ostream& out) { return impl_->tree.writeBinary(out); });
+  WriteTree(path, ".bt", stop,
+            [&](std::ostream& out) { return WriteBinaryOctree(impl_->tree, out); });
 }
 
 }  // namespace boicp

@@ -74,6 +74,17 @@ size_t SkipFullNode(const std::string& data, size_t offset, int depth) {
 
 }  // namespace
 
+bool WriteBinaryOctree(octomap::OcTree& tree, std::ostream& out) {
+  tree.toMaxLikelihood();
+  tree.prune();
+  out << "# Octomap OcTree binary file\n"
+      << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+      << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution()
+      << "\ndata\n";
+  tree.writeBinaryData(out);
+  return out.good();
+}
+
 std::unique_ptr<octomap::OcTree> ReadOctreeFile(const std::string& path) {
   std::ifstream in = io_detail::OpenOrThrow(path, std::ios::binary);
   std::string first_line;

@@ -1,12 +1,14 @@
 #pragma once
-// Reading an OctoMap file (.bt or .ot) written by OccupancyMap, quietly and
-// safely: OctoMap's own readers print "Reading ... octree type" lines on
-// stderr, and build garbage (with a cost that can grow exponentially) from a
-// file cut short, because they never check the stream while they recurse.
+// OctoMap files (.bt or .ot), read and written quietly and safely: OctoMap's
+// own readers print "Reading ... octree type" lines on stderr, and build
+// garbage (with a cost that can grow exponentially) from a file cut short,
+// because they never check the stream while they recurse; its .bt writer
+// prints " done." on stderr.
 
 #include <octomap/OcTree.h>
 
 #include <memory>
+#include <ostream>
 #include <string>
 
 namespace boicp {
@@ -15,5 +17,10 @@ namespace boicp {
 /// cannot be opened, is not an OctoMap OcTree, or its node data is cut short
 /// or malformed.
 std::unique_ptr<octomap::OcTree> ReadOctreeFile(const std::string& path);
+
+/// Writes `tree` to `out` as a .bt (header, then OctoMap's binary node data),
+/// the bytes OcTree::writeBinary writes: like it, first turns the tree into
+/// its maximum-likelihood form and prunes it. Returns whether `out` is good.
+bool WriteBinaryOctree(octomap::OcTree& tree, std::ostream& out);
 
 }  // namespace boicp

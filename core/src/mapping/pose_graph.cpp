@@ -5,12 +5,12 @@
 #include <numeric>
 #include <string>
 
-#include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/GlobalOptimization.h>
 #include <open3d/pipelines/registration/GlobalOptimizationConvergenceCriteria.h>
 #include <open3d/pipelines/registration/GlobalOptimizationMethod.h>
 #include <open3d/pipelines/registration/PoseGraph.h>
-#include <open3d/pipelines/registration/Registration.h>
+
+#include "boicp/registration/nearest_neighbors.hpp"
 
 namespace boicp {
 namespace {
@@ -23,12 +23,6 @@ int FindRoot(std::vector<int>& parent, int i) {
     i = parent[i];
   }
   return i;
-}
-
-open3d::geometry::PointCloud ToOpen3d(const Points& points) {
-  open3d::geometry::PointCloud cloud;
-  cloud.points_ = points;
-  return cloud;
 }
 
 bool IsLoopClosure(const std::vector<bool>& in_tree, size_t e) {
@@ -226,14 +220,24 @@ OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
 
 InformationMatrix PairInformation(const Points& source, const Points& target,
                                   const Transform& T_target_source, double max_distance) {
-  const open3d::geometry::PointCloud source_cloud = ToOpen3d(source);
-  const open3d::geometry::PointCloud target_cloud = ToOpen3d(target);
-  try {
-    return reg::GetInformationMatrixFromPointClouds(source_cloud, target_cloud, max_distance,
-                                                    T_target_source);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(std::string("information matrix: ") + e.what());
+  InformationMatrix information = InformationMatrix::Zero();
+  if (source.empty() || target.empty()) return information;
+  const NearestNeighborIndex index(target);
+  const double max_squared = max_distance * max_distance;
+  for (const Point& p : TransformPoints(T_target_source, source)) {
+    size_t match = 0;
+    double squared = 0.0;
+    if (!index.Nearest(p, max_squared, match, squared)) continue;
+    // How the matched target point moves under a small motion [rotation,
+    // translation] of the pair: d q / d [w, t] = [-[q]x | I].
+    const Point& q = target[match];
+    Eigen::Matrix<double, 3, 6> jacobian;
+    jacobian << 0.0, q.z(), -q.y(), 1.0, 0.0, 0.0,  //
+        -q.z(), 0.0, q.x(), 0.0, 1.0, 0.0,          //
+        q.y(), -q.x(), 0.0, 0.0, 0.0, 1.0;
+    information += jacobian.transpose() * jacobian;
   }
+  return information;
 }
 
 }  // namespace boicp

@@ -4,8 +4,7 @@
 
 namespace boicp {
 
-ThreadPool::ThreadPool(int threads, std::function<void()> on_thread_start)
-    : on_thread_start_(std::move(on_thread_start)) {
+ThreadPool::ThreadPool(int threads) {
   for (int i = 0; i < std::max(threads, 1); ++i) workers_.emplace_back([this] { Work(); });
 }
 
@@ -27,7 +26,6 @@ void ThreadPool::Submit(std::function<void()> task) {
 }
 
 void ThreadPool::Work() {
-  if (on_thread_start_) on_thread_start_();
   for (;;) {
     std::function<void()> task;
     {

@@ -89,10 +89,11 @@ OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
                                  const std::vector<bool>& in_tree, const PoseGraphOptions& options);
 
 /// Information matrix of a registered pair from its point correspondences
-/// within `max_distance` metres under T_target_source (Open3D's
-/// GetInformationMatrixFromPointClouds). Both clouds are in their sensor
-/// frames, metres; pass downsampled clouds, the cost is one kd-tree search
-/// per source point.
+/// within `max_distance` metres under T_target_source: the sum of J^T J over
+/// the matched target points q, with J = [-[q]x | I] (rotation first, as
+/// Open3D's GetInformationMatrixFromPointClouds). Both clouds are in their
+/// sensor frames, metres; pass downsampled clouds, the cost is one kd-tree
+/// search per source point.
 InformationMatrix PairInformation(const Points& source, const Points& target,
                                   const Transform& T_target_source, double max_distance);
 

@@ -2,7 +2,10 @@
 // A fixed set of worker threads running tasks in FIFO order: where the map
 // pipeline's pair registrations run. The daemon has one for all its jobs
 // (its size is --workers, so nothing else creates registration threads);
-// `boicp map` has one of --threads workers.
+// `boicp map` has one of --threads workers. Plain threads, not oneTBB tasks:
+// oneTBB gives a process one worker fewer than its cores unless a
+// process-wide global_control says otherwise, so --workers pairs would not
+// all run at once.
 
 #include <condition_variable>
 #include <deque>
@@ -15,9 +18,8 @@ namespace boicp {
 
 class ThreadPool {
  public:
-  /// Starts `threads` workers (at least 1). `on_thread_start` runs once on
-  /// each worker before any task (to set per-thread limits such as OpenMP's).
-  explicit ThreadPool(int threads, std::function<void()> on_thread_start = {});
+  /// Starts `threads` workers (at least 1).
+  explicit ThreadPool(int threads);
   /// Runs the tasks already queued, then joins the workers.
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
@@ -33,7 +35,6 @@ class ThreadPool {
   std::condition_variable ready_;
   std::deque<std::function<void()>> tasks_;
   bool stopping_ = false;
-  std::function<void()> on_thread_start_;
   std::vector<std::thread> workers_;
 };
 

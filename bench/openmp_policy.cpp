@@ -1,4 +1,4 @@
-#include "boicp/util/openmp_policy.hpp"
+#include "openmp_policy.hpp"
 
 #include <limits.h>
 #include <unistd.h>
