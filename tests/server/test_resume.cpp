@@ -107,11 +107,14 @@ TEST_F(Resume, JobTheDaemonDiedInTwiceFailsInsteadOfResuming) {
   auto client = Client();
   const std::string job_id = client.Submit(SlowBatch(UploadDrive(client, 3, 41))).job_id();
   for (int death = 0; death < 2; ++death) {
-    // This daemon's own log says it runs the job (the store said RUNNING already).
+    // This daemon's own log says it runs the job (the store said RUNNING
+    // already), and the job read says so too: the log line may appear between
+    // a read of the still queued job and the check.
     const v1::Job running = PollJob(
         client, job_id,
-        [&](const v1::Job&) {
-          return daemon_->Log().find("job " + job_id + " running") != std::string::npos;
+        [&](const v1::Job& job) {
+          return job.state() == v1::JOB_STATE_RUNNING &&
+                 daemon_->Log().find("job " + job_id + " running") != std::string::npos;
         },
         120);
     ASSERT_EQ(running.state(), v1::JOB_STATE_RUNNING);
