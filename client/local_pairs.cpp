@@ -85,6 +85,7 @@ PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex&
   record.inlier_rmse = r.inlier_rmse;
   record.confidence = r.confidence;
   record.overlap = r.overlap;
+  record.search_reach = r.search_reach;
   record.doubtful = r.doubtful;
   record.evaluations = r.evaluations;
   record.runtime_s = r.runtime_s;
@@ -112,6 +113,7 @@ json PairRecordToJson(const PairRecord& r) {
           {"confidence", r.confidence},
           {"doubtful", IsDoubtful(r)},
           {"overlap", r.overlap ? json(*r.overlap) : json(nullptr)},
+          {"search_reach", r.search_reach ? json(*r.search_reach) : json(nullptr)},
           {"evaluations", r.evaluations},
           {"runtime_s", r.runtime_s},
           {"seed", r.seed}};
@@ -162,6 +164,9 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
     if (j.contains("doubtful")) r.doubtful = j.at("doubtful").get<bool>();
     if (j.contains("overlap") && !j.at("overlap").is_null()) {
       r.overlap = j.at("overlap").get<double>();
+    }
+    if (j.contains("search_reach") && !j.at("search_reach").is_null()) {
+      r.search_reach = j.at("search_reach").get<double>();
     }
     r.evaluations = j.at("evaluations").get<int>();
     r.runtime_s = j.at("runtime_s").get<double>();

@@ -22,6 +22,9 @@ struct PairRecord {
   /// Fraction of the source the target sees (RegistrationResult::overlap);
   /// nullopt in files written before it was computed.
   std::optional<double> overlap;
+  /// RegistrationResult::search_reach; nullopt in files written before it
+  /// was computed.
+  std::optional<double> search_reach;
   /// confidence < kDoubtfulBelow; nullopt in files written before confidence
   /// was calibrated, which count as trusted.
   std::optional<bool> doubtful;
@@ -52,8 +55,8 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
 
 /// The JSON of pairs.json entries: source, target, source_path,
 /// target_path, transform (4x4 row-major), objective, fitness, inlier_rmse,
-/// confidence, doubtful, overlap (null when unknown), evaluations,
-/// runtime_s, seed.
+/// confidence, doubtful, overlap and search_reach (null when unknown),
+/// evaluations, runtime_s, seed.
 nlohmann::json PairRecordToJson(const PairRecord& record);
 
 /// Whether the record is marked doubtful (unmarked old files: no).

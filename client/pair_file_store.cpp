@@ -30,6 +30,7 @@ FinishedPair FinishedFromRecord(const PairRecord& record) {
   finished.information = edge.information;
   finished.confidence = edge.confidence;
   finished.planner_overlap = PlannerOverlap(record);
+  finished.search_reach = record.search_reach.value_or(0.0);
   finished.doubtful = IsDoubtful(record);
   return finished;
 }

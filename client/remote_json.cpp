@@ -73,6 +73,8 @@ nlohmann::json PairToJson(const v1::PairResult& pair) {
       {"confidence", pair.confidence()},
       {"doubtful", pair.doubtful()},
       {"overlap", pair.has_overlap() ? nlohmann::json(pair.overlap()) : nlohmann::json(nullptr)},
+      {"search_reach",
+       pair.has_search_reach() ? nlohmann::json(pair.search_reach()) : nlohmann::json(nullptr)},
       {"evaluations", pair.evaluations()},
       {"runtime_s", pair.runtime_s()},
       {"finished_at", pair.finished_at()},

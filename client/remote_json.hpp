@@ -28,8 +28,9 @@ nlohmann::json JobToJson(const v1::Job& job);
 
 /// {"source", "target", "source_scan_id", "target_scan_id", "transform"
 ///  (T_target_source), "objective", "fitness", "inlier_rmse", "confidence",
-///  "doubtful" (false when the daemon stored none), "overlap" (null when
-///  unknown), "evaluations", "runtime_s", "finished_at", "seed", "in_graph"}.
+///  "doubtful" (false when the daemon stored none), "overlap" and
+///  "search_reach" (null when unknown), "evaluations", "runtime_s",
+///  "finished_at", "seed", "in_graph"}.
 nlohmann::json PairToJson(const v1::PairResult& pair);
 
 /// The job's fields plus "pairs" (in plan order) and "trajectory"

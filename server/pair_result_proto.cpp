@@ -19,6 +19,7 @@ namespace boicp::server {
   out.set_confidence(r.confidence);
   out.set_doubtful(r.doubtful);
   out.set_overlap(r.overlap);
+  out.set_search_reach(r.search_reach);
   out.set_evaluations(static_cast<uint32_t>(r.evaluations));
   out.set_runtime_s(r.runtime_s);
   out.set_finished_at(rpc::NowSeconds());
@@ -36,6 +37,7 @@ FinishedPair FinishedFromProto(const ::boicp::v1::PairResult& result,
   finished.confidence = result.has_doubtful() ? result.confidence() : 1.0;
   finished.planner_overlap = result.has_overlap() ? result.overlap() : result.fitness();
   finished.doubtful = result.doubtful();
+  finished.search_reach = result.search_reach();
   return finished;
 }
 

@@ -52,42 +52,67 @@ TEST(MapPairs, DefaultOverlapThresholdsAreThePapers) {
   EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(CloudFormat::kDepthPng), 0.6);
 }
 
-// Feeds the planner overlap values from a table until it is done.
+using ProbeOutcome = KeyframePlanner::ProbeOutcome;
+
+// Feeds the planner probe outcomes from a table until it is done.
 std::vector<PairIndex> RunPlanner(int scans, double threshold,
-                                  const std::function<double(PairIndex)>& overlap, int window,
-                                  std::vector<PairIndex>* probed = nullptr) {
+                                  const std::function<ProbeOutcome(PairIndex)>& outcome,
+                                  int window) {
   KeyframePlanner planner(scans, threshold);
   for (int guard = 0; guard < 1000 && !planner.Done(); ++guard) {
     const auto probes = planner.NextProbes(window);
     if (probes.empty()) ADD_FAILURE() << "planner stalled";
-    for (const PairIndex& p : probes) {
-      if (probed) probed->push_back(p);
-      planner.Record(p, overlap(p));
-    }
+    for (const PairIndex& p : probes) planner.Record(p, outcome(p));
   }
   return planner.ChainPairs();
+}
+
+// Outcomes with this overlap, well inside the search box and not doubtful.
+std::function<ProbeOutcome(PairIndex)> Overlaps(const std::function<double(PairIndex)>& overlap) {
+  return [overlap](PairIndex p) { return ProbeOutcome{overlap(p), 0.0, false}; };
 }
 
 TEST(KeyframePlanner, NewKeyframeWhenOverlapDropsBelowThreshold) {
   // Overlap falls by 0.15 per scan of distance: scans 1 and 2 see keyframe 0
   // well enough (0.85, 0.7), scan 3 does not (0.55), so 2 becomes the keyframe.
   const auto overlap = [](PairIndex p) { return 1.0 - 0.15 * std::abs(p.source - p.target); };
-  EXPECT_THAT(RunPlanner(6, 0.7, overlap, 1),
+  EXPECT_THAT(RunPlanner(6, 0.7, Overlaps(overlap), 1),
               ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}, PairIndex{4, 2},
                           PairIndex{5, 4}));
 }
 
 TEST(KeyframePlanner, SameChainWhateverTheWindow) {
   const auto overlap = [](PairIndex p) { return 1.0 - 0.1 * std::abs(p.source - p.target); };
-  const auto one = RunPlanner(9, 0.75, overlap, 1);
-  EXPECT_EQ(RunPlanner(9, 0.75, overlap, 4), one);
-  EXPECT_EQ(RunPlanner(9, 0.75, overlap, 16), one);
+  const auto one = RunPlanner(9, 0.75, Overlaps(overlap), 1);
+  EXPECT_EQ(RunPlanner(9, 0.75, Overlaps(overlap), 4), one);
+  EXPECT_EQ(RunPlanner(9, 0.75, Overlaps(overlap), 16), one);
   EXPECT_EQ(one.size(), 8u);
 }
 
+// A drive whose scans overlap well at any distance (a long straight street),
+// while each step takes 0.3 of the search box: scan 2 hangs off keyframe 0
+// at 0.6 of the box, past half, so scan 3, which may lie outside keyframe
+// 0's box, is registered onto scan 2 instead.
+TEST(KeyframePlanner, AScanPastHalfTheSearchBoxBecomesTheKeyframe) {
+  const auto outcome = [](PairIndex p) {
+    return ProbeOutcome{0.9, 0.3 * std::abs(p.source - p.target), false};
+  };
+  const auto one = RunPlanner(6, 0.7, outcome, 1);
+  EXPECT_THAT(one, ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}, PairIndex{4, 2},
+                               PairIndex{5, 4}));
+  EXPECT_EQ(RunPlanner(6, 0.7, outcome, 4), one);
+}
+
+TEST(KeyframePlanner, ADoubtfulProbeCountsAsTooLittleOverlap) {
+  const auto outcome = [](PairIndex p) { return ProbeOutcome{0.9, 0.0, p == PairIndex{3, 0}}; };
+  EXPECT_THAT(RunPlanner(6, 0.7, outcome, 2),
+              ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}, PairIndex{4, 2},
+                          PairIndex{5, 2}));
+}
+
 TEST(KeyframePlanner, AdjacentScanIsKeptEvenWithLowOverlap) {
-  const auto overlap = [](PairIndex) { return 0.1; };
-  EXPECT_THAT(RunPlanner(3, 0.7, overlap, 2), ElementsAre(PairIndex{1, 0}, PairIndex{2, 1}));
+  EXPECT_THAT(RunPlanner(3, 0.7, Overlaps([](PairIndex) { return 0.1; }), 2),
+              ElementsAre(PairIndex{1, 0}, PairIndex{2, 1}));
 }
 
 TEST(KeyframePlanner, RejectsBadArguments) {

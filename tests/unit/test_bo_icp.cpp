@@ -180,6 +180,21 @@ TEST(BoIcp, PriorIsTheFirstSample) {
   EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
 }
 
+// The box is centred on the prior: an answer at the prior lies at its centre,
+// one 2 m along x from it at half of the 4 m bound.
+TEST(BoIcp, SearchReachIsTheAnswersOffsetFromTheBoxCentreOverItsBound) {
+  const StreetPair pair = MakeStreetPair(1.5);
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  ASSERT_DOUBLE_EQ(config.translation_bounds.x(), 4.0);
+  const RegistrationResult centred = RegisterPair(pair.source, pair.target, config, pair.truth);
+  EXPECT_LT(centred.search_reach, 0.02);
+  Transform shifted = pair.truth;
+  shifted(0, 3) -= 2.0;
+  const RegistrationResult half = RegisterPair(pair.source, pair.target, config, shifted);
+  ASSERT_LT(TranslationErrorM(half.transform, pair.truth), 0.1);
+  EXPECT_NEAR(half.search_reach, 0.5, 0.03);
+}
+
 TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
   const StreetPair pair = MakeStreetPair(0.9);
   BoIcpConfig config = SmallConfig(SearchMode::kNested);

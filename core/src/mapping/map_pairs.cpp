@@ -102,24 +102,30 @@ std::vector<PairIndex> KeyframePlanner::NextProbes(int max_count) {
   std::vector<PairIndex> probes;
   while (static_cast<int>(probes.size()) < max_count && next_probe_ < num_scans_) {
     const PairIndex probe{next_probe_++, keyframe_};
-    if (overlap_.count(probe) == 0) probes.push_back(probe);
+    if (outcomes_.count(probe) == 0) probes.push_back(probe);
   }
   return probes;
 }
 
-void KeyframePlanner::Record(const PairIndex& pair, double overlap) {
-  overlap_[pair] = overlap;
+void KeyframePlanner::Record(const PairIndex& pair, const ProbeOutcome& outcome) {
+  outcomes_[pair] = outcome;
   Advance();
 }
 
 void KeyframePlanner::Advance() {
   while (next_ < num_scans_) {
     const PairIndex probe{next_, keyframe_};
-    const auto found = overlap_.find(probe);
-    if (found == overlap_.end()) return;
-    if (found->second >= threshold_ || next_ == keyframe_ + 1) {
+    const auto found = outcomes_.find(probe);
+    if (found == outcomes_.end()) return;
+    const ProbeOutcome& outcome = found->second;
+    const bool sees_enough = !outcome.doubtful && outcome.overlap >= threshold_;
+    if (sees_enough || next_ == keyframe_ + 1) {
       chain_.push_back(probe);
       ++next_;
+      if (outcome.search_reach > kMaxKeyframeReach) {
+        keyframe_ = next_ - 1;  // the scan just attached
+        next_probe_ = next_;
+      }
       continue;
     }
     // Scan next_ sees too little of the keyframe: the scan before it takes

@@ -96,7 +96,7 @@ class PairScheduler {
     if (plan_.keyframes) {
       planner_.emplace(num_scans_, plan_.overlap_threshold);
       for (const auto& [pair, stored] : finished_) {
-        planner_->Record(pair, stored.planner_overlap);
+        planner_->Record(pair, ProbeOutcomeOf(stored));
         probed_sources_.insert(pair.source);
       }
     } else {
@@ -267,7 +267,7 @@ class PairScheduler {
     }
     if (!completion.finished) return;
     const FinishedPair& finished = finished_[completion.pair] = *completion.finished;
-    if (planner_) planner_->Record(completion.pair, finished.planner_overlap);
+    if (planner_) planner_->Record(completion.pair, ProbeOutcomeOf(finished));
     progress_.PairFinished(finished, /*reused=*/false, Counts());
   }
 

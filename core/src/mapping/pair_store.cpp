@@ -10,8 +10,13 @@ FinishedPair FinishedFromResult(const PairIndex& pair, const BatchPairResult& re
   finished.information = result.information;
   finished.confidence = r.confidence;
   finished.planner_overlap = r.overlap;
+  finished.search_reach = r.search_reach;
   finished.doubtful = r.doubtful;
   return finished;
+}
+
+KeyframePlanner::ProbeOutcome ProbeOutcomeOf(const FinishedPair& finished) {
+  return {finished.planner_overlap, finished.search_reach, finished.doubtful};
 }
 
 PairConstraint ConstraintOf(const FinishedPair& finished) {

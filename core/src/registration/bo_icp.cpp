@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -194,8 +195,30 @@ double BasinSupport(const std::vector<Evaluation>& history, const Transform& ans
   return first_stage > 0 ? static_cast<double>(in_basin) / first_stage : 0.0;
 }
 
+// Where a search's translation box lies: centred, for each rotation R, on
+// pivot - R * source_centroid (the rotation turns the source about the pivot).
+struct SearchBox {
+  Point pivot = Point::Zero();
+  Point source_centroid = Point::Zero();
+  Eigen::Vector3d translation_bounds = Eigen::Vector3d::Zero();
+};
+
+// RegistrationResult::search_reach of `T` in `box`. An axis the search does
+// not move along (bound 0) does not count.
+double SearchReach(const SearchBox& box, const Transform& T) {
+  const Point centre = box.pivot - T.topLeftCorner<3, 3>() * box.source_centroid;
+  const Point offset = T.topRightCorner<3, 1>() - centre;
+  double reach = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double bound = box.translation_bounds[axis];
+    if (bound > 0.0) reach = std::max(reach, std::abs(offset[axis]) / bound);
+  }
+  return reach;
+}
+
 // One search (nested or 6 DOF) and the refinement of its distinct best ends.
 struct SearchOutcome {
+  SearchBox box;
   std::shared_ptr<const PreparedPair> prepared;  // kept for a wider refinement
   RefinedAlignment refined;
   double overlap = 0.0;  // RegistrationResult::overlap of the refined answer
@@ -255,6 +278,7 @@ SearchOutcome SearchAndRefine(const Points& source, const Points& target, const 
   Search search(pair, config, callbacks);
   SearchOutcome out;
   out.prepared = prepared_pair;
+  out.box = {pivot, Centroid(search_source), config.translation_bounds};
   BayesOptResult last;
   if (config.mode == SearchMode::kNested) {
     const BayesOptResult rotation = search.RunStage(
@@ -378,6 +402,7 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   result.fitness = kept.refined.score.fitness;
   result.inlier_rmse = kept.refined.score.inlier_rmse;
   result.overlap = kept.overlap;
+  result.search_reach = SearchReach(kept.box, result.transform);
   result.probability_better = kept.probability_better;
   result.features = kept.features;
   result.confidence = kept.confidence;

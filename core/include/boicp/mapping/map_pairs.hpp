@@ -69,11 +69,18 @@ double DefaultOverlapThreshold(CloudFormat format);
 /// alignment lower it without less being seen). While the overlap stays at
 /// or above the threshold the scan hangs off k. When scan j falls below it,
 /// scan j-1 becomes the next keyframe and j is registered onto that one
-/// instead (the probe j -> k is dropped). A scan adjacent to its keyframe is always kept,
-/// however small its overlap, so the chain never breaks.
+/// instead (the probe j -> k is dropped). A doubtful probe counts as too
+/// little overlap. A scan adjacent to its keyframe is always kept, however
+/// small its overlap, so the chain never breaks.
 ///
-/// Decisions depend only on the overlap values recorded, never on the order
-/// they arrive in, so a resumed batch makes the same choices. Probes can run
+/// A keyframe also reaches only so far. Its search box does not follow the
+/// drive (without priors it is centred on the clouds' centroids, which lag
+/// the motion when a scan sees more on one side), so once a scan hangs off k
+/// more than kMaxKeyframeReach into its box, the next scan, a step further,
+/// may lie outside and look right anyway. That scan becomes the keyframe.
+///
+/// Decisions depend only on the outcomes recorded, never on the order they
+/// arrive in, so a resumed batch makes the same choices. Probes can run
 /// ahead (NextProbes); those beyond a keyframe change are wasted but harmless.
 class KeyframePlanner {
  public:
@@ -84,11 +91,23 @@ class KeyframePlanner {
   /// keyframe, in scan order. Empty when the plan needs results first or is done.
   std::vector<PairIndex> NextProbes(int max_count);
 
-  /// Records a finished probe's overlap estimate (in [0, 1]; results stored
-  /// before overlap was computed pass their fitness) and advances the plan
-  /// as far as the recorded results allow. Results for pairs the plan no
-  /// longer needs are kept but change nothing.
-  void Record(const PairIndex& pair, double overlap);
+  /// What the planner reads of a finished probe.
+  struct ProbeOutcome {
+    /// Overlap estimate in [0, 1] (results stored before overlap was
+    /// computed pass their fitness).
+    double overlap = 0.0;
+    double search_reach = 0.0;  // RegistrationResult::search_reach
+    bool doubtful = false;
+  };
+
+  /// Half the box: a drive's next scan is then still inside it as long as
+  /// scans are less than half the translation bounds apart.
+  static constexpr double kMaxKeyframeReach = 0.5;
+
+  /// Records a finished probe and advances the plan as far as the recorded
+  /// results allow. Results for pairs the plan no longer needs are kept but
+  /// change nothing.
+  void Record(const PairIndex& pair, const ProbeOutcome& outcome);
 
   /// True once every scan hangs off a keyframe.
   bool Done() const { return next_ >= num_scans_; }
@@ -107,7 +126,7 @@ class KeyframePlanner {
   int keyframe_ = 0;
   int next_ = 1;        // first scan not yet attached
   int next_probe_ = 1;  // first scan not yet handed out as a probe onto keyframe_
-  std::map<PairIndex, double> overlap_;
+  std::map<PairIndex, ProbeOutcome> outcomes_;
   std::vector<PairIndex> chain_;
 };
 

@@ -23,11 +23,17 @@ struct FinishedPair {
   /// The keyframe planner's overlap estimate in [0, 1]; results stored
   /// before overlap was computed give their fitness.
   double planner_overlap = 0.0;
+  /// RegistrationResult::search_reach; results stored before it was
+  /// recorded give 0.
+  double search_reach = 0.0;
   bool doubtful = false;  // confidence below kDoubtfulBelow
 };
 
 /// A result registered in this run, as the pipeline sees it.
 FinishedPair FinishedFromResult(const PairIndex& pair, const BatchPairResult& result);
+
+/// What the keyframe planner reads of a finished pair.
+KeyframePlanner::ProbeOutcome ProbeOutcomeOf(const FinishedPair& finished);
 
 /// The pose-graph edge of a finished pair.
 PairConstraint ConstraintOf(const FinishedPair& finished);

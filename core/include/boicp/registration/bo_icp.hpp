@@ -60,6 +60,12 @@ struct RegistrationResult {
   /// Fraction of the search-voxel source within 1.5 search voxels of the
   /// target: how much of the source the target sees, for keyframe choice.
   double overlap = 0.0;
+  /// How far into the search's translation box the answer lies: the largest
+  /// offset from the box's centre over the axes, each as a fraction of that
+  /// axis's bound (above 1: outside the box). The box is centred on the prior,
+  /// or without one on the clouds' centroids, so this says how far a drive's
+  /// next scan may be from what the search can reach.
+  double search_reach = 0.0;
   /// Estimated probability, in [0,1], that `transform` is within the success
   /// thresholds (2 degrees, and a few refinement voxels).
   double confidence = 0.0;
