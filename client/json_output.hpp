@@ -15,7 +15,7 @@ nlohmann::json TransformToJson(const Transform& T);
 nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts);
 
 /// {"transform", "objective", "fitness", "inlier_rmse", "overlap",
-///  "confidence", "doubtful", "attempts", "evaluations", "runtime_s",
+///  "search_reach", "confidence", "doubtful", "attempts", "evaluations", "runtime_s",
 ///  "config" (the settings used: settings::ConfigToJson), "auto"
 ///  (`auto_fields`: the settings chosen from the clouds), plus GP and
 ///  point-count details}.

@@ -130,6 +130,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   for (const json& p : pairs) {
     ASSERT_TRUE(p.contains("doubtful") && p["doubtful"].is_boolean()) << p.dump();
     ASSERT_TRUE(p.contains("overlap") && p["overlap"].is_number()) << p.dump();
+    ASSERT_TRUE(p.contains("search_reach") && p["search_reach"].is_number()) << p.dump();
     EXPECT_EQ(p["doubtful"].get<bool>(), p["confidence"].get<double>() < 0.5);
     EXPECT_GT(p["overlap"].get<double>(), 0.0);
     doubtful += p["doubtful"].get<bool>();
@@ -137,12 +138,13 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   EXPECT_EQ(json::parse(first.out)["pairs_doubtful"], doubtful);
   EXPECT_THAT(first.err, HasSubstr(std::to_string(doubtful) + " of 3 pairs doubtful"));
 
-  // Files written before the marks existed load as trusted, overlap unknown;
-  // a file marked doubtful is counted as such.
+  // Files written before the marks existed load as trusted, overlap and
+  // reach unknown; a file marked doubtful is counted as such.
   for (const char* name : {"000000-000001.json", "000001-000002.json"}) {
     EditPairFile(out / "pairs" / name, [](json& j) {
       j.erase("doubtful");
       j.erase("overlap");
+      j.erase("search_reach");
     });
   }
   EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) {
@@ -158,6 +160,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   pairs = json::parse(Slurp(out / "pairs.json"));
   EXPECT_EQ(pairs[0]["doubtful"], false);
   EXPECT_TRUE(pairs[0]["overlap"].is_null());
+  EXPECT_TRUE(pairs[0]["search_reach"].is_null());
   EXPECT_EQ(pairs[2]["doubtful"], true);
 }
 

@@ -67,6 +67,9 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
     EXPECT_TRUE(j["config"].contains(name.get<std::string>())) << name << " names no setting";
   }
   EXPECT_FALSE(j["doubtful"].get<bool>());
+  // The answer lies inside its search box.
+  EXPECT_GE(j["search_reach"].get<double>(), 0.0);
+  EXPECT_LE(j["search_reach"].get<double>(), 1.0);
   // The first search is nested, (10 + 20) evaluations per stage; a doubtful
   // one is tried again. The answer is the one attempt kept.
   ASSERT_GE(j["attempts"].size(), 1u);

@@ -199,6 +199,7 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
     EXPECT_EQ(pair["doubtful"].get<bool>(), pair["confidence"].get<double>() < 0.5);
     ASSERT_TRUE(pair["overlap"].is_number()) << pair.dump();
     EXPECT_GT(pair["overlap"].get<double>(), 0.0);
+    ASSERT_TRUE(pair["search_reach"].is_number()) << pair.dump();
     doubtful += pair["doubtful"].get<bool>();
   }
   EXPECT_EQ(j["pairs_doubtful"], doubtful);
