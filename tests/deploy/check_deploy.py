@@ -232,10 +232,10 @@ def check_copied_binaries(args, instructions, stages):
 
 
 def check_base_stage(instructions, known_env, root, base):
-    runtime = [(k, a) for stage, k, a in instructions if stage == base]
     by_keyword = {}
-    for keyword, argument in runtime:
-        by_keyword.setdefault(keyword, []).append(argument)
+    for stage, keyword, argument in instructions:
+        if stage == base:
+            by_keyword.setdefault(keyword, []).append(argument)
     problems = []
     health = by_keyword.get("HEALTHCHECK", [])
     if len(health) != 1 or exec_form(health[0].partition("CMD")[2])[:2] != ["boicp", "health"]:

@@ -263,22 +263,22 @@ SearchOutcome SearchAndRefine(const Points& source, const Points& target, const 
   const PairContext pair{prepared, std::move(evaluation_source), std::move(coarse_source),
                          SearchIcpOptions(config)};
   const Points& search_source = prepared.search_source;
+  const Point source_centroid = Centroid(search_source);
 
   // Without a prior the box is centred on "same orientation, centroids on top
   // of each other"; with one, on the prior itself.
   const Transform anchor = prior.value_or([&] {
     Transform centroids = Transform::Identity();
-    centroids.topRightCorner<3, 1>() =
-        Centroid(prepared.search_target.points()) - Centroid(search_source);
+    centroids.topRightCorner<3, 1>() = Centroid(prepared.search_target.points()) - source_centroid;
     return centroids;
   }());
   const Point pivot =
-      anchor.topLeftCorner<3, 3>() * Centroid(search_source) + anchor.topRightCorner<3, 1>();
+      anchor.topLeftCorner<3, 3>() * source_centroid + anchor.topRightCorner<3, 1>();
 
   Search search(pair, config, callbacks);
   SearchOutcome out;
   out.prepared = prepared_pair;
-  out.box = {pivot, Centroid(search_source), config.translation_bounds};
+  out.box = {pivot, source_centroid, config.translation_bounds};
   BayesOptResult last;
   if (config.mode == SearchMode::kNested) {
     const BayesOptResult rotation = search.RunStage(
@@ -290,8 +290,7 @@ SearchOutcome SearchAndRefine(const Points& source, const Points& target, const 
     // The ICP result itself is the second sample.
     const Transform rotated = search.Best().result;
     Transform centred = rotated;
-    centred.topRightCorner<3, 1>() =
-        pivot - rotated.topLeftCorner<3, 3>() * Centroid(search_source);
+    centred.topRightCorner<3, 1>() = pivot - rotated.topLeftCorner<3, 3>() * source_centroid;
     const SearchSpace translation =
         MakeSearchSpace(centred, pivot, Eigen::Vector3d::Zero(), config.translation_bounds);
     last = search.RunStage(1, translation, "translation",
