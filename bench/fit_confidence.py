@@ -6,7 +6,8 @@ usage: fit_confidence.py --fit CSV [CSV...] --test CSV [CSV...]
 
 Every CSV is a boicp-bench results.csv. Rows of the BO methods (those with
 the feature columns) are the samples, `success` the label. The model is a
-logistic regression of success on fitness and margin, fitted by Newton's method with a small ridge penalty on
+logistic regression of success on fitness, the log of the margin and the
+refinement's angular resolution, fitted by Newton's method with a small ridge penalty on
 the --fit rows. It prints the weights as C++ constants, then for the --test
 rows (never used in the fit): the AUROC, the share of failures flagged
 doubtful (confidence < 0.5), the share of successes flagged, and a
@@ -17,30 +18,42 @@ retry), with no fit.
 
 import argparse
 import csv
+import math
 import sys
 
 import numpy as np
 
 # The results.csv also carries rmse_ratio, support and probability_better.
-# With them the held-out AUROC was no better (0.992 against 0.990), and the
-# weights they took (support and P(better) positive) left flipped 7-Scenes
-# pairs outside the fit at confidence 0.65-0.96; fitness and margin alone
-# flag them.
-FEATURES = ["fitness", "margin"]
-CONSTANTS = ["kFitness", "kMargin"]
+# They separated held-out runs no better, and the weights they took (support
+# and P(better) positive) left flipped 7-Scenes pairs outside the fit at
+# confidence 0.65-0.96. resolution_deg is what tells a fine fit at too
+# coarse a refinement voxel (the bunny at the fixed settings, 2-3 degrees
+# off) from a right answer: nothing else about those answers differs.
+#
+# The margin enters as a log: what marks a wrong answer is a near tie (two
+# basins within a few per cent of each other's fitness), and a linear margin
+# barely tells 2 % from 15 %. MARGIN_FLOOR is about the resolution of a
+# fitness measured on thousands of points; it is kMarginFloor in confidence.cpp.
+MARGIN_FLOOR = 0.01
+FEATURES = {
+    "kFitness": lambda row: float(row["fitness"]),
+    "kLogMargin": lambda row: math.log(float(row["margin"]) + MARGIN_FLOOR),
+    "kResolutionDeg": lambda row: float(row["resolution_deg"]),
+}
+RECORDED = {"confidence": lambda row: float(row["confidence"])}
 RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
 
 
-def read_samples(paths, columns=FEATURES):
-    features, labels = [], []
+def read_samples(paths, features=FEATURES):
+    samples, labels = [], []
     for path in paths:
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
                 if row["experiment"] != "suite" or row.get("fitness", "") == "":
                     continue
-                features.append([float(row[name]) for name in columns])
+                samples.append([feature(row) for feature in features.values()])
                 labels.append(1.0 if row["success"] == "1" else 0.0)
-    return np.array(features), np.array(labels)
+    return np.array(samples), np.array(labels)
 
 
 def fit_logistic(x, y):
@@ -52,6 +65,7 @@ def fit_logistic(x, y):
         hessian = design.T @ (design * (p * (1 - p))[:, None]) + RIDGE * np.diag(
             np.r_[0.0, np.ones(len(w) - 1)])
         step = np.linalg.solve(hessian, gradient)
+        step *= min(1.0, 5.0 / max(np.abs(step).max(), 1e-12))  # damped: separable rows
         w -= step
         if np.abs(step).max() < 1e-10:
             break
@@ -93,7 +107,7 @@ def main(argv):
     parser.add_argument("--check", nargs="+")
     args = parser.parse_args(argv)
     if args.check:
-        confidence, y_check = read_samples(args.check, ["confidence"])
+        confidence, y_check = read_samples(args.check, RECORDED)
         if len(y_check) == 0:
             sys.exit("fit_confidence.py: no BO rows with features in the --check files")
         print(f"{len(y_check)} runs ({int((1 - y_check).sum())} failures), recorded confidence")
@@ -108,7 +122,7 @@ def main(argv):
     w = fit_logistic(x_fit, y_fit)
     print(f"fitted on {len(y_fit)} runs ({int((1 - y_fit).sum())} failures)")
     print(f"constexpr double kIntercept = {w[0]:.4g};")
-    for name, weight in zip(CONSTANTS, w[1:]):
+    for name, weight in zip(FEATURES, w[1:]):
         print(f"constexpr double {name} = {weight:.4g};")
 
     print(f"\ntested on {len(y_test)} other runs ({int((1 - y_test).sum())} failures)")

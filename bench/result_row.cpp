@@ -29,9 +29,9 @@ std::string Text(const std::string& value) {
 }
 
 std::string Features(const std::optional<ConfidenceFeatures>& f) {
-  if (!f) return ",,,,";
+  if (!f) return ",,,,,";
   return Number(f->fitness) + ',' + Number(f->rmse_ratio) + ',' + Number(f->margin) + ',' +
-         Number(f->support) + ',' + Number(f->probability_better);
+         Number(f->support) + ',' + Number(f->probability_better) + ',' + Number(f->resolution_deg);
 }
 
 }  // namespace
@@ -41,7 +41,7 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
   out << "experiment,dataset,source,target,method,threads,seed,perturb,voxel,iterations,"
          "source_points,target_points,evaluations,wall_s,rot_err_deg,trans_err_m,mean_p2p_m,"
          "overlap,success,confidence,icp_s,model_s,attempts,retry_s,fitness,rmse_ratio,margin,"
-         "support,probability_better,error\n";
+         "support,probability_better,resolution_deg,error\n";
   for (const ResultRow& r : rows) {
     out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ',' << Text(r.target)
         << ',' << r.method << ',' << r.threads << ',' << r.seed << ',' << r.perturb << ','

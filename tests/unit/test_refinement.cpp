@@ -1,9 +1,12 @@
 // The shared stages around the search: per-pair preparation and the
 // coarse-to-fine refinement every initialiser ends with.
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "boicp/io/synthetic_scene.hpp"
+#include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/refinement.hpp"
 
 namespace boicp {
@@ -88,6 +91,33 @@ TEST(Refinement, TheStartThatFitsBestWinsWhateverItsPlaceInTheList) {
     EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
   }
   EXPECT_THROW(RefineCoarseToFine({}, pair, config), InputError);
+}
+
+TEST(Refinement, RmsRadiusOfACubesCornersIsItsHalfDiagonal) {
+  Points corners;
+  for (double x : {-1.0, 1.0})
+    for (double y : {-1.0, 1.0})
+      for (double z : {-1.0, 1.0}) corners.push_back(Point(x, y, z) * 0.5 + Point(3.0, -2.0, 7.0));
+  EXPECT_NEAR(RmsRadius(corners), 0.5 * std::sqrt(3.0), 1e-12);
+  EXPECT_EQ(RmsRadius({}), 0.0);
+}
+
+// The confidence reads how finely the finest level can place a rotation:
+// the angle that moves a point at the source's RMS radius by one voxel.
+TEST(Refinement, ResolutionIsOneRefineVoxelSeenFromTheSourcesRmsRadius) {
+  const KnownPair known = MakeKnownPair();
+  const Points& finest = known.pair.pyramid.back().source;
+  const RefinedAlignment refined =
+      RefineCoarseToFine({Transform::Identity()}, known.pair, known.config);
+  EXPECT_NEAR(refined.resolution_deg, std::atan(0.1 / RmsRadius(finest)) * 180.0 / M_PI, 1e-9);
+
+  BoIcpConfig finer = known.config;
+  finer.refine_voxel = 0.05;
+  const PreparedPair finer_pair = PreparePair(finest, finest, finer);
+  const double halved =
+      RefineCoarseToFine({Transform::Identity()}, finer_pair, finer).resolution_deg;
+  EXPECT_GT(halved, 0.4 * refined.resolution_deg);
+  EXPECT_LT(halved, 0.6 * refined.resolution_deg);
 }
 
 TEST(Refinement, CloudEmptiedByCroppingIsAnInputErrorNamingIt) {

@@ -159,16 +159,10 @@ CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
   const Points points = RandomSubsample(cloud, kMeasuredPoints, seed);
   CloudStatistics stats;
   stats.points = cloud.size();
-  const Point centroid = Centroid(points);
-  Eigen::Vector3d squares = Eigen::Vector3d::Zero();
   std::vector<double> ranges;
   ranges.reserve(points.size());
-  for (const Point& p : points) {
-    squares += (p - centroid).cwiseAbs2();
-    ranges.push_back(p.norm());
-  }
-  squares /= static_cast<double>(points.size());
-  stats.rms_radius = std::sqrt(squares.sum());
+  for (const Point& p : points) ranges.push_back(p.norm());
+  stats.rms_radius = RmsRadius(points);
   if (!(stats.rms_radius > 1e-9)) {
     throw InputError("a cloud has all its points in one place, nothing" + advice);
   }

@@ -242,6 +242,7 @@ void RefineEnds(SearchOutcome& out, int count, const BoIcpConfig& config,
   out.features.fitness = out.refined.score.fitness;
   out.features.rmse_ratio = out.refined.score.inlier_rmse / config.EffectiveInlierDistance();
   out.features.margin = out.refined.margin;
+  out.features.resolution_deg = out.refined.resolution_deg;
   out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
   out.features.probability_better = out.probability_better;
   out.confidence = Confidence(out.features);

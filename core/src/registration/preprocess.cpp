@@ -1,6 +1,7 @@
 #include "boicp/registration/preprocess.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 
@@ -50,6 +51,15 @@ Point Centroid(const Points& points) {
   Point sum = Point::Zero();
   for (const Point& p : points) sum += p;
   return points.empty() ? sum : Point(sum / static_cast<double>(points.size()));
+}
+
+double RmsRadius(const Points& points) {
+  if (points.empty()) return 0.0;
+  const Point centre = Centroid(points);
+  Eigen::Vector3d squares = Eigen::Vector3d::Zero();
+  for (const Point& p : points) squares += (p - centre).cwiseAbs2();
+  squares /= static_cast<double>(points.size());
+  return std::sqrt(squares.sum());
 }
 
 }  // namespace boicp

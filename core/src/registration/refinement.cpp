@@ -1,6 +1,7 @@
 #include "boicp/registration/refinement.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -20,6 +21,14 @@ std::vector<double> RefinementVoxels(double search_voxel, double refine_voxel) {
   for (double v = search_voxel / 2; v > refine_voxel * 1.01; v /= 2) voxels.push_back(v);
   voxels.push_back(refine_voxel);
   return voxels;
+}
+
+// The angle (degrees) that moves a point at the cloud's RMS radius by one
+// voxel: ICP on voxel centroids cannot place a rotation much more finely,
+// however well the answer fits.
+double AngularResolutionDeg(const Points& cloud, double voxel) {
+  const double rms_radius = RmsRadius(cloud);
+  return rms_radius > 0.0 ? std::atan(voxel / rms_radius) * 180.0 / M_PI : 180.0;
 }
 
 }  // namespace
@@ -142,7 +151,8 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   std::iota(order.begin(), order.end(), size_t{0});
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return scores[a].fitness > scores[b].fitness; });
-  RefinedAlignment refined{alive[order[0]].T, scores[order[0]], 1.0};
+  RefinedAlignment refined{alive[order[0]].T, scores[order[0]], 1.0,
+                           AngularResolutionDeg(finest.source, finest.voxel)};
   if (order.size() > 1 && refined.score.fitness > 0.0) {
     refined.margin = 1.0 - scores[order[1]].fitness / refined.score.fitness;
   }

@@ -6,13 +6,15 @@
 namespace boicp {
 
 /// What the engine knows about its own answer when it finishes. The model
-/// weighs fitness and margin; the rest is reported for fitting and diagnosis.
+/// weighs fitness, log(margin) and resolution; the rest is reported for fitting
+/// and diagnosis.
 struct ConfidenceFeatures {
   double fitness = 0.0;     // inlier fraction at the finest level, in [0, 1]
   double rmse_ratio = 0.0;  // inlier RMSE / inlier distance, in [0, 1]
   double margin = 0.0;      // RefinedAlignment::margin, in [0, 1]
   double support = 0.0;     // share of the first stage's runs that ended in the answer's basin
   double probability_better = 0.0;  // the surrogate's P(an unexplored start does better)
+  double resolution_deg = 0.0;      // RefinedAlignment::resolution_deg
 };
 
 /// Estimated probability, in (0, 1), that the answer is within the success

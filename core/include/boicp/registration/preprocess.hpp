@@ -23,4 +23,8 @@ Points RandomSubsample(const Points& points, size_t max_points, uint64_t seed);
 /// Mean of the points (zero for an empty input).
 Point Centroid(const Points& points);
 
+/// Root-mean-square distance of the points from their centroid, in their
+/// units (zero for an empty input).
+double RmsRadius(const Points& points);
+
 }  // namespace boicp

@@ -57,6 +57,10 @@ struct RefinedAlignment {
   /// 1 - (runner-up's fitness / the answer's fitness) at the finest level, in
   /// [0, 1]: 0 when another basin fits as well, 1 when none reached that level.
   double margin = 1.0;
+  /// The angle that moves a finest-level source point at the cloud's RMS
+  /// radius by one refinement voxel, degrees: how finely that level can
+  /// resolve the rotation.
+  double resolution_deg = 0.0;
 };
 
 /// Coarse-to-fine point-to-point ICP from each of `starts` (T_target_source,
