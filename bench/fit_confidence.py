@@ -7,13 +7,13 @@ usage: fit_confidence.py --fit CSV [CSV...] --test CSV [CSV...]
 Every CSV is a boicp-bench results.csv. Rows of the BO methods (those with
 the feature columns) are the samples, `success` the label. The model is a
 logistic regression of success on fitness, the log of the margin and the
-refinement's angular resolution, fitted by Newton's method with a small ridge penalty on
-the --fit rows. It prints the weights as C++ constants, then for the --test
-rows (never used in the fit): the AUROC, the share of failures flagged
-doubtful (confidence < 0.5), the share of successes flagged, and a
-reliability table. --check reports the same for the confidence the engine
-itself recorded in the rows (the shipped model, final answers after any
-retry), with no fit.
+refinement's angular resolution, fitted by Newton's method with a small
+ridge penalty on the --fit rows. It prints the weights as C++ constants,
+then for the --test rows (never used in the fit): the AUROC, the share of
+failures flagged doubtful (confidence < 0.5), the share of successes
+flagged, and a reliability table. --check reports the same for the
+confidence the engine itself recorded in the rows (the shipped model, final
+answers after any retry), with no fit.
 """
 
 import argparse

@@ -28,7 +28,7 @@ TEST(Confidence, MoreInliersAndAWiderMarginAreMoreCertain) {
 
 // The bunny's answer at the fixed settings (a 2.5 mm refinement voxel, 2.4
 // degrees at its RMS radius) ends 2.1 degrees off with the same fit as a
-// right one; at two point spacings (0.6 degrees) the same fit is right.
+// right one; at the automatic 0.56 mm voxel (0.57 degrees) it is right.
 TEST(Confidence, AFitAtTooCoarseARefinementVoxelIsDoubtful) {
   EXPECT_LT(Confidence(Features(0.506, 0.315, 2.37)), 0.5);
   EXPECT_GT(Confidence(Features(0.506, 0.315, 0.57)), 0.5);
