@@ -2,11 +2,12 @@
 
 #include <chrono>
 #include <fstream>
-#include <future>
+#include <utility>
 
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/registration/voxel_cloud.hpp"
 #include "boicp/util/atomic_file.hpp"
+#include "boicp/util/parallel_for.hpp"
 
 namespace boicp {
 namespace {
@@ -115,20 +116,31 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
     return PrepareScan(map, scans[index], poses[index], settings, want_cloud,
                        callbacks.stop_requested);
   };
-  // A two-stage pipeline: scan i+1 is loaded and ray cast on a helper thread
-  // while this thread applies scan i to the tree, in scan order. Whether the
-  // helper exists changes only timing, never the tree. A stop request ends
-  // the ray casting, the tree update and the tree writes from inside, so a
-  // large scan or map does not hold a cancel or a drain back.
-  const bool pipelined = settings.fusion_threads > 1;
-  std::future<PreparedScan> next;
+  // A two-stage pipeline: scan i+1 is loaded and ray cast beside this
+  // thread while it applies scan i to the tree, in scan order. With one
+  // fusion thread the two stages run one after the other; either way only
+  // the timing differs, never the tree. A stop request ends the ray casting,
+  // the tree update and the tree writes from inside, so a large scan or map
+  // does not hold a cancel or a drain back.
+  const int stages = settings.fusion_threads > 1 ? 2 : 1;
+  PreparedScan current;
+  if (total > 0) {
+    ThrowIfStopped(callbacks);
+    current = prepare(0);
+  }
   for (int i = 0; i < total; ++i) {
     ThrowIfStopped(callbacks);
-    PreparedScan current = next.valid() ? next.get() : prepare(i);
-    if (pipelined && i + 1 < total) next = std::async(std::launch::async, prepare, i + 1);
-    map.ApplyUpdate(current.update, callbacks.stop_requested);
-    if (want_cloud) cloud.Add(current.cloud_points, poses[static_cast<size_t>(i)]);
+    PreparedScan next;
+    ParallelFor(i + 1 < total ? 2 : 1, stages, [&](size_t stage) {
+      if (stage == 1) {
+        next = prepare(i + 1);
+        return;
+      }
+      map.ApplyUpdate(current.update, callbacks.stop_requested);
+      if (want_cloud) cloud.Add(current.cloud_points, poses[static_cast<size_t>(i)]);
+    });
     Report(callbacks, "fusing", i + 1, total);
+    current = std::move(next);
   }
 
   ThrowIfStopped(callbacks);

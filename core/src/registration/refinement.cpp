@@ -72,7 +72,10 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
   ParallelFor(2 * voxels.size(), config.threads, [&](size_t task) {
     const size_t level = task / 2;
     if (task % 2 == 1) {
-      targets[level].emplace(PrepareCloud(target, config, voxels[level], "target"));
+      // Every search evaluation queries the search level's target; the finer
+      // ones serve a few refinement runs, too few to pay for neighbour lists.
+      targets[level].emplace(PrepareCloud(target, config, voxels[level], "target"),
+                             /*neighbour_lists=*/level == 0);
     } else if (level == 0) {
       sources[level] = PrepareCloud(source, config, voxels[level], "source");
     } else {
