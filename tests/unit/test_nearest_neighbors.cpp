@@ -5,6 +5,7 @@
 
 #include <limits>
 #include <random>
+#include <string>
 
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/nearest_neighbors.hpp"
