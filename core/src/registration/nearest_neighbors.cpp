@@ -132,7 +132,7 @@ bool NearestNeighborIndex::Nearest(const Point& query, double max_squared_distan
 bool NearestNeighborIndex::NearestWithHint(const Point& query, size_t hint,
                                            double max_squared_distance, size_t& index,
                                            double& squared_distance) const {
-  const double hint_squared = (tree_->adaptor.points[hint] - query).squaredNorm();
+  const double hint_squared = SquaredDistance(query, tree_->adaptor.points[hint]);
   if (!(hint_squared < max_squared_distance)) {
     return Nearest(query, max_squared_distance, index, squared_distance);
   }
