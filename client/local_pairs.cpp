@@ -90,7 +90,7 @@ PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex&
   record.evaluations = r.evaluations;
   record.runtime_s = r.runtime_s;
   record.seed = result.seed;
-  record.information = result.information;
+  record.information = r.information;
   record.settings = std::move(settings);
   return record;
 }

@@ -16,7 +16,7 @@ std::vector<FinishedPair> JobPairStore::LoadFinished() {
 
 void JobPairStore::Save(const PairIndex& pair, int listing_order, const BatchPairResult& result) {
   v1::PairResult proto = PairResultToProto(spec_, pair, result);
-  store_.PutPair(spec_.job_id, listing_order, proto, result.information);
+  store_.PutPair(spec_.job_id, listing_order, proto, result.registration.information);
   std::lock_guard<std::mutex> lock(mutex_);
   results_[pair] = std::move(proto);
 }

@@ -193,23 +193,5 @@ TEST(OptimizePoseGraph, DoubtfulLoopClosureThatAgreesIsKept) {
   EXPECT_LT(MaxTranslationError(optimised.poses, truth), 1e-6);
 }
 
-TEST(PairInformation, IsTheMatchedPointsInertiaAndVanishesWithoutOverlap) {
-  const Points world = MakeSyntheticStreet(3, 10.0);
-  const Points scan = SimulateScan(world, Pose(0, 0, 0), 20.0, 0.0, 1);
-  const InformationMatrix info = PairInformation(scan, scan, Transform::Identity(), 0.3);
-  // Every point matches itself: the translation block counts the matches, and
-  // the rotation block is the points' inertia tensor, sum |q|^2 I - q q^T.
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
-  for (const Point& q : scan)
-    inertia += q.squaredNorm() * Eigen::Matrix3d::Identity() - q * q.transpose();
-  const Eigen::Matrix3d rotation_block = info.topLeftCorner(3, 3);
-  const Eigen::Matrix3d translation_block = info.bottomRightCorner(3, 3);
-  const double matches = static_cast<double>(scan.size());
-  EXPECT_TRUE(translation_block.isApprox(matches * Eigen::Matrix3d::Identity(), 1e-12));
-  EXPECT_TRUE(rotation_block.isApprox(inertia, 1e-9));
-  const InformationMatrix none = PairInformation(scan, scan, Pose(0, 100, 0), 0.3);
-  EXPECT_LT(none(5, 5), 1.0);
-}
-
 }  // namespace
 }  // namespace boicp

@@ -2,16 +2,8 @@
 
 #include <algorithm>
 
-#include "boicp/registration/voxel_cloud.hpp"
-
 namespace boicp {
 namespace {
-
-Points Downsample(const Points& points, double voxel) {
-  VoxelAccumulator grid(voxel);
-  grid.Add(points);
-  return grid.Centroids();
-}
 
 const ScanSource& ScanAt(const std::vector<ScanSource>& scans, int index) {
   if (index < 0 || index >= static_cast<int>(scans.size())) {
@@ -39,10 +31,6 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
   out.seed = config.seed;
   out.registration =
       RegisterPair(source_points, target_points, config, PairPrior(source, target), callbacks);
-  const double voxel = config.EffectiveRefineVoxel();
-  out.information =
-      PairInformation(Downsample(source_points, voxel), Downsample(target_points, voxel),
-                      out.registration.transform, config.EffectiveInlierDistance());
   return out;
 }
 

@@ -7,7 +7,7 @@ FinishedPair FinishedFromResult(const PairIndex& pair, const BatchPairResult& re
   FinishedPair finished;
   finished.pair = pair;
   finished.transform = r.transform;
-  finished.information = result.information;
+  finished.information = r.information;
   finished.confidence = r.confidence;
   finished.planner_overlap = r.overlap;
   finished.search_reach = r.search_reach;

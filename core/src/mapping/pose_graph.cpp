@@ -10,8 +10,6 @@
 #include <open3d/pipelines/registration/GlobalOptimizationMethod.h>
 #include <open3d/pipelines/registration/PoseGraph.h>
 
-#include "boicp/registration/nearest_neighbors.hpp"
-
 namespace boicp {
 namespace {
 
@@ -216,28 +214,6 @@ OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
     }
   }
   return OptimizeActiveEdges(initial, constraints, in_tree, active, options);
-}
-
-InformationMatrix PairInformation(const Points& source, const Points& target,
-                                  const Transform& T_target_source, double max_distance) {
-  InformationMatrix information = InformationMatrix::Zero();
-  if (source.empty() || target.empty()) return information;
-  const NearestNeighborIndex index(target);
-  const double max_squared = max_distance * max_distance;
-  for (const Point& p : TransformPoints(T_target_source, source)) {
-    size_t match = 0;
-    double squared = 0.0;
-    if (!index.Nearest(p, max_squared, match, squared)) continue;
-    // How the matched target point moves under a small motion [rotation,
-    // translation] of the pair: d q / d [w, t] = [-[q]x | I].
-    const Point& q = target[match];
-    Eigen::Matrix<double, 3, 6> jacobian;
-    jacobian << 0.0, q.z(), -q.y(), 1.0, 0.0, 0.0,  //
-        -q.z(), 0.0, q.x(), 0.0, 1.0, 0.0,          //
-        q.y(), -q.x(), 0.0, 0.0, 0.0, 1.0;
-    information += jacobian.transpose() * jacobian;
-  }
-  return information;
 }
 
 }  // namespace boicp

@@ -401,6 +401,9 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   result.objective = kept.objective;
   result.fitness = kept.refined.score.fitness;
   result.inlier_rmse = kept.refined.score.inlier_rmse;
+  const PyramidLevel& finest = kept.prepared->pyramid.back();
+  result.information = PairInformation(finest.source, finest.target, result.transform,
+                                       config.EffectiveInlierDistance());
   result.overlap = kept.overlap;
   result.search_reach = SearchReach(kept.box, result.transform);
   result.probability_better = kept.probability_better;

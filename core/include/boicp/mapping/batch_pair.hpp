@@ -1,7 +1,7 @@
 #pragma once
 // One pair registration of a scan batch, as the daemon's workers and the
-// one-shot `boicp map` command both run it: the pair's own seed, the scans'
-// prior poses, and the information matrix the pose graph weighs it by.
+// one-shot `boicp map` command both run it: with the pair's own seed, centred
+// on the scans' prior poses.
 
 #include <cstdint>
 #include <functional>
@@ -18,7 +18,6 @@ namespace boicp {
 
 struct BatchPairResult {
   RegistrationResult registration;  // transform = T_target_source
-  InformationMatrix information;    // from correspondences at the refine voxel
   uint64_t seed = 0;                // the pair's seed, PairSeed(job seed, pair)
 };
 

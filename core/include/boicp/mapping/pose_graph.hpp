@@ -9,11 +9,10 @@
 
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/registration/bo_icp.hpp"
+#include "boicp/registration/pair_information.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
-
-using InformationMatrix = Eigen::Matrix<double, 6, 6>;
 
 /// One registered pair as a pose-graph edge.
 struct PairConstraint {
@@ -87,14 +86,5 @@ struct OptimizedPoses {
 OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
                                  const std::vector<PairConstraint>& constraints,
                                  const std::vector<bool>& in_tree, const PoseGraphOptions& options);
-
-/// Information matrix of a registered pair from its point correspondences
-/// within `max_distance` metres under T_target_source: the sum of J^T J over
-/// the matched target points q, with J = [-[q]x | I] (rotation first, as
-/// Open3D's GetInformationMatrixFromPointClouds). Both clouds are in their
-/// sensor frames, metres; pass downsampled clouds, the cost is one kd-tree
-/// search per source point.
-InformationMatrix PairInformation(const Points& source, const Points& target,
-                                  const Transform& T_target_source, double max_distance);
 
 }  // namespace boicp

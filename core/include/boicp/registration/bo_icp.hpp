@@ -10,6 +10,7 @@
 
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/config.hpp"
+#include "boicp/registration/pair_information.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -57,6 +58,9 @@ struct RegistrationResult {
   double objective = 0.0;    // best search objective (truncated mean NN distance, metres)
   double fitness = 0.0;      // fraction of refined source points within inlier_distance
   double inlier_rmse = 0.0;  // RMS distance of those points, metres
+  /// How firmly those inliers pin down `transform` (PairInformation over the
+  /// refined source points, within inlier_distance): a pose graph's edge weight.
+  InformationMatrix information = InformationMatrix::Zero();
   /// Fraction of the search-voxel source within 1.5 search voxels of the
   /// target: how much of the source the target sees, for keyframe choice.
   double overlap = 0.0;

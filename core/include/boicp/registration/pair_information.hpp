@@ -1,0 +1,23 @@
+#pragma once
+// How firmly a registered pair's point correspondences pin down its
+// transform: the information matrix a pose graph weighs the pair's edge by.
+
+#include <Eigen/Core>
+
+#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/util/types.hpp"
+
+namespace boicp {
+
+/// 6 x 6, rotation first, then translation (Open3D's pose-graph convention).
+using InformationMatrix = Eigen::Matrix<double, 6, 6>;
+
+/// The sum of J^T J over the target points q matched within `max_distance`
+/// metres by the source points moved by T_target_source, with
+/// J = [-[q]x | I]: how the matched point moves under a small rotation and
+/// translation (as Open3D's GetInformationMatrixFromPointClouds). Zero when
+/// nothing matches. The cost is one nearest-neighbour search per source point.
+InformationMatrix PairInformation(const Points& source, const NearestNeighborIndex& target,
+                                  const Transform& T_target_source, double max_distance);
+
+}  // namespace boicp

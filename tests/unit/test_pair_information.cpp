@@ -1,0 +1,62 @@
+// The information matrix of a registered pair, and the one RegisterPair
+// reports with its answer.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "boicp/io/synthetic_scene.hpp"
+#include "boicp/registration/bo_icp.hpp"
+#include "boicp/registration/evaluation.hpp"
+#include "boicp/registration/pair_information.hpp"
+#include "boicp/registration/refinement.hpp"
+
+namespace boicp {
+namespace {
+
+TEST(PairInformation, IsTheMatchedPointsInertiaAndVanishesWithoutOverlap) {
+  const Points world = MakeSyntheticStreet(3, 10.0);
+  const Points scan =
+      SimulateScan(world, PoseFromYawTranslation(0.0, Eigen::Vector3d::Zero()), 20.0, 0.0, 1);
+  const NearestNeighborIndex index(scan);
+  const InformationMatrix info = PairInformation(scan, index, Transform::Identity(), 0.3);
+  // Every point matches itself: the translation block counts the matches, and
+  // the rotation block is the points' inertia tensor, sum |q|^2 I - q q^T.
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+  for (const Point& q : scan)
+    inertia += q.squaredNorm() * Eigen::Matrix3d::Identity() - q * q.transpose();
+  const Eigen::Matrix3d rotation_block = info.topLeftCorner(3, 3);
+  const Eigen::Matrix3d translation_block = info.bottomRightCorner(3, 3);
+  const double matches = static_cast<double>(scan.size());
+  EXPECT_TRUE(translation_block.isApprox(matches * Eigen::Matrix3d::Identity(), 1e-12));
+  EXPECT_TRUE(rotation_block.isApprox(inertia, 1e-9));
+  const InformationMatrix none =
+      PairInformation(scan, index, PoseFromYawTranslation(0.0, {0.0, 100.0, 0.0}), 0.3);
+  EXPECT_TRUE(none.isZero());
+}
+
+// The answer's information counts the finest level's inliers, the same
+// points its fitness is the share of.
+TEST(PairInformation, RegisterPairReportsItForTheFinestLevelInliers) {
+  const Points world = MakeSyntheticStreet(11, 15.0);
+  const Transform T_world_target = PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8});
+  const Transform T_world_source = PoseFromYawTranslation(0.4, {1.2, 0.4, 1.8});
+  const Points source = SimulateScan(world, T_world_source, 30.0, 0.01, 1);
+  const Points target = SimulateScan(world, T_world_target, 30.0, 0.01, 2);
+  BoIcpConfig config = PresetConfig("A");
+  config.automatic.clear();
+  config.retry_when_doubtful = false;
+  config.seed = 3;
+  const RegistrationResult result = RegisterPair(source, target, config);
+  ASSERT_LT(RotationErrorDeg(result.transform, T_world_target.inverse() * T_world_source), 1.0);
+
+  const size_t finest_points = PreparePair(source, target, config).pyramid.back().source.size();
+  const double inliers = result.fitness * static_cast<double>(finest_points);
+  EXPECT_GT(inliers, 100.0);
+  for (int axis = 3; axis < 6; ++axis) EXPECT_NEAR(result.information(axis, axis), inliers, 0.5);
+  const Eigen::SelfAdjointEigenSolver<InformationMatrix> spectrum(result.information);
+  EXPECT_GT(spectrum.eigenvalues().minCoeff(), 0.0);
+}
+
+}  // namespace
+}  // namespace boicp
