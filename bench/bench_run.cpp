@@ -94,6 +94,7 @@ class BenchRun {
 
   void WriteResults() const {
     WriteTextFileAtomically(Path("results.csv"), FormatResultsCsv(rows_));
+    WriteTextFileAtomically(Path("attempts.csv"), FormatAttemptsCsv(rows_));
   }
 
   std::string Path(const std::string& name) const {

@@ -27,13 +27,21 @@ BoIcpConfig PresetForDataset(const std::string& preset, const MethodInput& input
     given.random_samples = std::min(preset_config.random_samples, kQuickBoSamples);
     given.iterations = std::min(preset_config.iterations, kQuickBoSamples);
   }
-  return settings::ConfigFromSettings(given);
+  BoIcpConfig config = settings::ConfigFromSettings(given);
+  config.budget = Budget::kFixed;
+  return config;
 }
 
 }  // namespace
 
 BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input) {
   return PresetForDataset(preset, input, input.dataset.automatic_settings);
+}
+
+BoIcpConfig DatasetAutoConfig(const MethodInput& input) {
+  BoIcpConfig config = PresetForDataset("C", input, /*automatic=*/true);
+  config.budget = Budget::kAuto;
+  return config;
 }
 
 BoIcpConfig DatasetTableConfig(const std::string& preset, const MethodInput& input) {

@@ -18,8 +18,14 @@ constexpr int kQuickBoSamples = 10;
 /// and a search voxel of dataset.voxel scaled by the preset's voxel relative
 /// to C's (so A and B stay 7/6 coarser, as in the paper); or, with
 /// dataset.automatic_settings, voxel and bounds left for RegisterPair to
-/// choose from the pair. The input's seed and thread budget.
+/// choose from the pair. The input's seed and thread budget; the paper's
+/// fixed budget (Budget::kFixed).
 BoIcpConfig DatasetBoConfig(const std::string& preset, const MethodInput& input);
+
+/// Preset C as `boicp register` runs it with no flags: settings chosen from
+/// the pair and the ladder's budget (Budget::kAuto), whatever the dataset
+/// table says; the input's seed and thread budget.
+BoIcpConfig DatasetAutoConfig(const MethodInput& input);
 
 /// As DatasetBoConfig, always with the dataset table's voxel and bounds: the
 /// baselines' settings, which --auto-settings leaves as they are.

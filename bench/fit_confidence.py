@@ -3,6 +3,7 @@
 
 usage: fit_confidence.py --fit CSV [CSV...] --test CSV [CSV...]
        fit_confidence.py --check CSV [CSV...]
+       fit_confidence.py --folds CSV [CSV...]
 
 Every CSV is a boicp-bench results.csv. Rows of the BO methods (those with
 the feature columns) are the samples, `success` the label. The model is a
@@ -13,7 +14,11 @@ then for the --test rows (never used in the fit): the AUROC, the share of
 failures flagged doubtful (confidence < 0.5), the share of successes
 flagged, and a reliability table. --check reports the same for the
 confidence the engine itself recorded in the rows (the shipped model, final
-answers after any retry), with no fit.
+answers after any retry), with no fit. --folds fits leave-one-dataset-out:
+for each dataset, on every other dataset's rows, then tests on that one's;
+it also reports the shipped model (the recorded confidence) per dataset.
+The CSVs may be attempts.csv files, whose rows are every attempt of every
+rung (prior, features, searches, retries), each judged on its own answer.
 """
 
 import argparse
@@ -44,16 +49,24 @@ RECORDED = {"confidence": lambda row: float(row["confidence"])}
 RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
 
 
-def read_samples(paths, features=FEATURES):
-    samples, labels = [], []
+def read_rows(paths):
+    rows = []
     for path in paths:
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
-                if row["experiment"] != "suite" or row.get("fitness", "") == "":
-                    continue
-                samples.append([feature(row) for feature in features.values()])
-                labels.append(1.0 if row["success"] == "1" else 0.0)
-    return np.array(samples), np.array(labels)
+                if row["experiment"] == "suite" and row.get("fitness", "") != "":
+                    rows.append(row)
+    return rows
+
+
+def as_samples(rows, features=FEATURES):
+    samples = [[feature(row) for feature in features.values()] for row in rows]
+    labels = [1.0 if row["success"] == "1" else 0.0 for row in rows]
+    return np.array(samples).reshape(len(rows), len(features)), np.array(labels)
+
+
+def read_samples(paths, features=FEATURES):
+    return as_samples(read_rows(paths), features)
 
 
 def fit_logistic(x, y):
@@ -100,12 +113,36 @@ def report(p, y_test):
                   f"{y_test[inside].mean():.3f} |")
 
 
+def flagged(p, y):
+    failures, successes = y == 0, y == 1
+    return (f"{int((p[failures] < 0.5).sum())}/{int(failures.sum())} failures and "
+            f"{int((p[successes] < 0.5).sum())}/{int(successes.sum())} successes flagged doubtful")
+
+
+def folds(paths):
+    rows = read_rows(paths)
+    datasets = sorted({row["dataset"] for row in rows})
+    print("| held out | runs | refit on the others | shipped model |\n|---|---:|---|---|")
+    for held_out in datasets:
+        fit_rows = [row for row in rows if row["dataset"] != held_out]
+        test_rows = [row for row in rows if row["dataset"] == held_out]
+        w = fit_logistic(*as_samples(fit_rows))
+        x_test, y_test = as_samples(test_rows)
+        shipped, _ = as_samples(test_rows, RECORDED)
+        print(f"| {held_out} | {len(test_rows)} | {flagged(predict(w, x_test), y_test)} | "
+              f"{flagged(shipped[:, 0], y_test)} |")
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--fit", nargs="+")
     parser.add_argument("--test", nargs="+")
     parser.add_argument("--check", nargs="+")
+    parser.add_argument("--folds", nargs="+")
     args = parser.parse_args(argv)
+    if args.folds:
+        folds(args.folds)
+        return
     if args.check:
         confidence, y_check = read_samples(args.check, RECORDED)
         if len(y_check) == 0:

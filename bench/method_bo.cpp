@@ -1,4 +1,6 @@
-// bo-A, bo-B, bo-C (nested) and bo-C-6dof: core's RegisterPair as it is.
+// bo-A, bo-B, bo-C (nested) and bo-C-6dof: core's RegisterPair with the
+// paper's fixed budget; bo-C-auto: the ladder, as `boicp register` runs it
+// with no flags.
 
 #include <optional>
 
@@ -26,9 +28,15 @@ MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& in
   output.attempts = static_cast<int>(result.attempts.size());
   for (size_t k = 1; k < result.attempts.size(); ++k)
     output.retry_s += result.attempts[k].runtime_s;
+  output.answered_by = RungName(result.answered_by);
+  output.attempt_details = result.attempts;
   output.icp_s = split.icp_s;
   output.model_s = split.model_s;
   return output;
+}
+
+MethodOutput RunBoIcpAuto(const MethodInput& input) {
+  return RunBoIcpWithConfig(DatasetAutoConfig(input), input);
 }
 
 MethodOutput RunBoIcp(const std::string& preset, bool six_dof, const MethodInput& input) {

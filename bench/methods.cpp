@@ -5,9 +5,9 @@
 namespace boicp::bench {
 
 const std::vector<std::string>& MethodNames() {
-  static const std::vector<std::string> kNames = {"bo-A",      "bo-B",        "bo-C",
-                                                  "bo-C-6dof", "naive",       "icp-identity",
-                                                  "pyramid",   "ransac-fpfh", "fgr"};
+  static const std::vector<std::string> kNames = {
+      "bo-A",  "bo-B",         "bo-C",    "bo-C-6dof",   "bo-C-auto",
+      "naive", "icp-identity", "pyramid", "ransac-fpfh", "fgr"};
   return kNames;
 }
 
@@ -16,6 +16,7 @@ MethodOutput RunMethod(const std::string& name, const MethodInput& input) {
   if (name == "bo-B") return RunBoIcp("B", false, input);
   if (name == "bo-C") return RunBoIcp("C", false, input);
   if (name == "bo-C-6dof") return RunBoIcp("C", true, input);
+  if (name == "bo-C-auto") return RunBoIcpAuto(input);
   if (name == "naive") return RunNaiveBoIcp(input);
   if (name == "icp-identity") return RunIcpFromIdentity(input);
   if (name == "pyramid") return RunPyramid(input);
@@ -38,6 +39,11 @@ std::vector<std::string> DescribeMethods(const std::vector<std::string>& names, 
       line += "core RegisterPair, preset C (N_r 30, N 60, dataset voxel), nested";
     } else if (name == "bo-C-6dof") {
       line += "core RegisterPair, preset C, one 6-DOF search (N_r 30, N 60)";
+    } else if (name == "bo-C-auto") {
+      line +=
+          "core RegisterPair as `boicp register` runs it with no flags: preset C, settings "
+          "chosen from the pair, the escalation ladder (features, short search, full search, "
+          "retry; no prior)";
     } else if (name == "naive") {
       line +=
           "core RegisterPair with preset C (as bo-C), but every search evaluation calls Open3D "

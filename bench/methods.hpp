@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/config.hpp"
 #include "boicp/util/types.hpp"
@@ -39,6 +40,8 @@ struct MethodOutput {
   std::optional<ConfidenceFeatures> features;
   int attempts = 0;
   double retry_s = 0.0;
+  std::string answered_by;               // BO only: RungName of the rung whose answer was kept
+  std::vector<Attempt> attempt_details;  // BO only: every attempt, with its answer
 };
 
 /// Every method name, in the order tables and plots list them.
@@ -53,6 +56,7 @@ std::vector<std::string> DescribeMethods(const std::vector<std::string>& names, 
 // The methods themselves, one file each.
 MethodOutput RunBoIcp(const std::string& preset, bool six_dof, const MethodInput& input);
 MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& input);
+MethodOutput RunBoIcpAuto(const MethodInput& input);
 MethodOutput RunNaiveBoIcp(const MethodInput& input);
 MethodOutput RunIcpFromIdentity(const MethodInput& input);
 MethodOutput RunPyramid(const MethodInput& input);

@@ -42,7 +42,12 @@ ResultRow Timed(const std::string& method, const BenchPair& pair, const DatasetS
     row.model_s = output.model_s;
     row.features = output.features;
     row.attempts = output.attempts;
+    row.answered_by = output.answered_by;
     row.retry_s = output.retry_s;
+    for (const Attempt& a : output.attempt_details) {
+      row.attempt_rows.push_back({AttemptKindName(a.kind), SearchModeName(a.mode), a.features,
+                                  a.confidence, evaluator.Evaluate(a.transform).success, a.kept});
+    }
   } catch (const std::exception& e) {
     // Open3D reports its errors as std::runtime_error: a failed method is a
     // result (it counts against the success rate), not the end of the run.

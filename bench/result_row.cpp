@@ -41,7 +41,7 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
   out << "experiment,dataset,source,target,method,threads,seed,perturb,voxel,iterations,"
          "source_points,target_points,evaluations,wall_s,rot_err_deg,trans_err_m,mean_p2p_m,"
          "overlap,success,confidence,icp_s,model_s,attempts,retry_s,fitness,rmse_ratio,margin,"
-         "support,probability_better,resolution_deg,error\n";
+         "support,probability_better,resolution_deg,answered_by,error\n";
   for (const ResultRow& r : rows) {
     out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ',' << Text(r.target)
         << ',' << r.method << ',' << r.threads << ',' << r.seed << ',' << r.perturb << ','
@@ -51,7 +51,23 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
         << ',' << Number(r.mean_p2p_m) << ',' << Number(r.overlap, "%.4f") << ','
         << (r.success ? 1 : 0) << ',' << Optional(r.confidence) << ',' << Optional(r.icp_s) << ','
         << Optional(r.model_s) << ',' << r.attempts << ',' << Number(r.retry_s, "%.4f") << ','
-        << Features(r.features) << ',' << Text(r.error) << '\n';
+        << Features(r.features) << ',' << r.answered_by << ',' << Text(r.error) << '\n';
+  }
+  return out.str();
+}
+
+std::string FormatAttemptsCsv(const std::vector<ResultRow>& rows) {
+  std::ostringstream out;
+  out << "experiment,dataset,source,target,method,attempt,kind,mode,fitness,rmse_ratio,margin,"
+         "support,probability_better,resolution_deg,confidence,success,kept\n";
+  for (const ResultRow& r : rows) {
+    for (size_t k = 0; k < r.attempt_rows.size(); ++k) {
+      const AttemptRow& a = r.attempt_rows[k];
+      out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ','
+          << Text(r.target) << ',' << r.method << ',' << k << ',' << a.kind << ',' << a.mode << ','
+          << Features(a.features) << ',' << Number(a.confidence) << ',' << (a.success ? 1 : 0)
+          << ',' << (a.kept ? 1 : 0) << '\n';
+    }
   }
   return out.str();
 }

@@ -10,6 +10,17 @@
 
 namespace boicp::bench {
 
+/// One attempt of a BO registration, judged like a method's answer: the
+/// samples bench/fit_confidence.py fits the confidence on, from every rung.
+struct AttemptRow {
+  std::string kind;  // AttemptKindName
+  std::string mode;  // SearchModeName
+  ConfidenceFeatures features;
+  double confidence = 0.0;
+  bool success = false;
+  bool kept = false;
+};
+
 struct ResultRow {
   std::string experiment = "suite";  // "suite", "scaling-voxel" or "scaling-iterations"
   std::string dataset;
@@ -36,11 +47,19 @@ struct ResultRow {
   std::optional<ConfidenceFeatures> features;  // BO only
   int attempts = 0;                            // BO only: searches made (2 = retried)
   double retry_s = 0.0;                        // BO only: wall time of the retry, in wall_s
+  std::string answered_by;                     // BO only: the rung whose answer was kept
   std::string error;                           // what the method threw, if it did
+  std::vector<AttemptRow> attempt_rows;        // BO only
 };
 
 /// The CSV text: a header line, then one line per row. NaN and absent values
 /// are empty fields; commas and quotes in text fields are quoted.
 std::string FormatResultsCsv(const std::vector<ResultRow>& rows);
+
+/// attempts.csv: one line per attempt of every BO row (dataset, pair, method,
+/// the attempt's kind and mode, its confidence features, its confidence,
+/// whether its own answer met the dataset's success thresholds, and whether
+/// it was kept).
+std::string FormatAttemptsCsv(const std::vector<ResultRow>& rows);
 
 }  // namespace boicp::bench

@@ -23,7 +23,7 @@ BIN=""
 DATA_ROOT="$ROOT/../shared/data"
 THREADS=2
 SEED=20230301  # fixed: the same perturbations and method seeds on every run
-METHODS="bo-A,bo-B,bo-C,bo-C-6dof,naive,icp-identity,pyramid,ransac-fpfh,fgr"
+METHODS="bo-A,bo-B,bo-C,bo-C-6dof,bo-C-auto,naive,icp-identity,pyramid,ransac-fpfh,fgr"
 
 while [ $# -gt 0 ]; do
   case "$1" in

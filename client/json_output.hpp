@@ -10,12 +10,13 @@ namespace boicp::cli {
 /// 4x4 row-major nested array.
 nlohmann::json TransformToJson(const Transform& T);
 
-/// One object per search made: mode, seed, fitness, confidence, evaluations,
-/// runtime_s, kept.
+/// One object per attempt made: kind, mode, seed, fitness, confidence,
+/// evaluations, refined_ends, runtime_s, kept.
 nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts);
 
 /// {"transform", "objective", "fitness", "inlier_rmse", "overlap",
-///  "search_reach", "confidence", "doubtful", "attempts", "evaluations", "runtime_s",
+///  "search_reach", "confidence", "doubtful", "attempts", "answered_by"
+///  (RungName), "evaluations" (of every rung), "runtime_s",
 ///  "config" (the settings used: settings::ConfigToJson), "auto"
 ///  (`auto_fields`: the settings chosen from the clouds), plus GP and
 ///  point-count details}.

@@ -7,6 +7,7 @@
 
 #include "boicp/mapping/map_pipeline.hpp"
 #include "boicp/mapping/map_preview.hpp"
+#include "boicp/settings/rung_summary.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "boicp/util/thread_pool.hpp"
 #include "pair_file_store.hpp"
@@ -78,6 +79,7 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   summary.pairs = static_cast<int>(listed.size());
   summary.pairs_doubtful = static_cast<int>(std::count_if(
       listed.begin(), listed.end(), [](const PairRecord& r) { return IsDoubtful(r); }));
+  for (const PairRecord& r : listed) summary.answered_by.push_back(r.answered_by);
   return summary;
 }
 
@@ -91,6 +93,16 @@ PairExecution LocalExecution(ThreadPool& pool) {
 }
 
 }  // namespace
+
+void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir) {
+  std::fprintf(stderr,
+               "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
+               "preview.png}: %zu occupied leaves\n",
+               out_dir.c_str(), summary.occupied_leaves);
+  std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
+  const std::string rungs = settings::RungSummary(summary.answered_by);
+  if (!rungs.empty()) std::fprintf(stderr, "%s\n", rungs.c_str());
+}
 
 MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads) {
   const MapBatch batch = RunBatch(run, RunPlan(run));

@@ -16,10 +16,15 @@ struct MapOutputSummary {
   bool optimised = false;
   size_t occupied_leaves = 0;
   double fusion_s = 0.0;
-  int pairs = 0;           // listed in pairs.json
-  int pairs_doubtful = 0;  // of which doubtful
-  int pairs_reused = 0;    // taken from OUTDIR/pairs instead of registered
+  int pairs = 0;                  // listed in pairs.json
+  int pairs_doubtful = 0;         // of which doubtful
+  int pairs_reused = 0;           // taken from OUTDIR/pairs instead of registered
+  std::vector<Rung> answered_by;  // of each pair listed, the rung whose answer was kept
 };
+
+/// What `map` and `merge` close with on stderr: the files written into
+/// `out_dir`, how many pairs are doubtful and how many each rung answered.
+void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir);
 
 /// The whole run into OUTDIR: every pair (reusing files with the run's
 /// settings), then map.bt, map.ot, trajectory.tum, trajectory.kitti,

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "boicp/settings/rung_summary.hpp"
 #include "boicp/settings/settings_json.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "json_output.hpp"
@@ -49,6 +50,9 @@ json PairConfigJson(const BoIcpConfig& config) {
 // a config is read under the old names and written as PairSettings writes it
 // now, so that those pairs are reused rather than registered again.
 void UpgradeOldPairConfig(json& config, const std::string& source) {
+  // Pairs registered before the budget existed ran the paper's full search,
+  // which the fixed budget still runs; an auto run registers them again.
+  if (!config.contains("budget")) config["budget"] = BudgetName(Budget::kFixed);
   if (!config.contains("retry_when_doubtful")) return;
   static const std::pair<const char*, const char*> kRenamed[] = {
       {"max_correspondence_distance", "max_correspondence"},
@@ -61,6 +65,14 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
   // Their searches ran point-to-point ICP, the only one there was.
   if (!config.contains("icp_objective")) config["icp_objective"] = "point";
   config = PairConfigJson(settings::ConfigFromJson(config, source));
+}
+
+// A pair file's answered_by: one of RungName's words.
+Rung RungOfFile(const json& value) {
+  const std::string name = value.get<std::string>();
+  const std::optional<Rung> rung = settings::RungFromName(name);
+  if (!rung) throw InputError("answered_by: unknown rung '" + name + "'");
+  return *rung;
 }
 
 }  // namespace
@@ -87,6 +99,7 @@ PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex&
   record.overlap = r.overlap;
   record.search_reach = r.search_reach;
   record.doubtful = r.doubtful;
+  record.answered_by = r.answered_by;
   record.evaluations = r.evaluations;
   record.runtime_s = r.runtime_s;
   record.seed = result.seed;
@@ -114,6 +127,7 @@ json PairRecordToJson(const PairRecord& r) {
           {"doubtful", IsDoubtful(r)},
           {"overlap", r.overlap ? json(*r.overlap) : json(nullptr)},
           {"search_reach", r.search_reach ? json(*r.search_reach) : json(nullptr)},
+          {"answered_by", RungName(r.answered_by)},
           {"evaluations", r.evaluations},
           {"runtime_s", r.runtime_s},
           {"seed", r.seed}};
@@ -168,6 +182,7 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
     if (j.contains("search_reach") && !j.at("search_reach").is_null()) {
       r.search_reach = j.at("search_reach").get<double>();
     }
+    if (j.contains("answered_by")) r.answered_by = RungOfFile(j.at("answered_by"));
     r.evaluations = j.at("evaluations").get<int>();
     r.runtime_s = j.at("runtime_s").get<double>();
     r.seed = j.at("seed").get<uint64_t>();

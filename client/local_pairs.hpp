@@ -28,7 +28,10 @@ struct PairRecord {
   /// confidence < kDoubtfulBelow; nullopt in files written before confidence
   /// was calibrated, which count as trusted.
   std::optional<bool> doubtful;
-  int evaluations = 0;
+  /// The rung whose answer was kept; files written before it was recorded
+  /// read as the full search, which every answer then was.
+  Rung answered_by = Rung::kFullSearch;
+  int evaluations = 0;  // ICP runs of every rung together
   double runtime_s = 0.0;
   uint64_t seed = 0;  // the pair's own seed
   InformationMatrix information = InformationMatrix::Identity();
@@ -50,13 +53,15 @@ std::string PairFilePath(const std::string& out_dir, const PairIndex& pair);
 void WritePairFile(const std::string& out_dir, const PairRecord& record);
 
 /// The stored record, or nullopt when there is no file. Throws InputError
-/// naming the file when it exists but does not parse.
+/// naming the file when it exists but does not parse. Files written before
+/// the budget existed ran the full search: their config reads as budget
+/// "fixed", and their answer as the full search's.
 std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairIndex& pair);
 
 /// The JSON of pairs.json entries: source, target, source_path,
 /// target_path, transform (4x4 row-major), objective, fitness, inlier_rmse,
 /// confidence, doubtful, overlap and search_reach (null when unknown),
-/// evaluations, runtime_s, seed.
+/// answered_by (RungName), evaluations, runtime_s, seed.
 nlohmann::json PairRecordToJson(const PairRecord& record);
 
 /// Whether the record is marked doubtful (unmarked old files: no).

@@ -99,11 +99,7 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
   WriteTextFileAtomically(RunManifestPath(out), RunManifestJson(run).dump(1) + "\n");
 
   const MapOutputSummary summary = BuildLocalMap(run, out, flags.threads);
-  std::fprintf(stderr,
-               "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
-               "preview.png}: %zu occupied leaves\n",
-               out.c_str(), summary.occupied_leaves);
-  std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
+  PrintMapClosing(summary, out);
   if (flags.json) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

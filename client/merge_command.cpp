@@ -52,11 +52,7 @@ int RunMerge(const MergeFlags& flags) {
     fs::create_directories(flags.out_dir);
     WriteTextFileAtomically(RunManifestPath(flags.out_dir), RunManifestJson(run).dump(1) + "\n");
     const MapOutputSummary summary = AssembleStoredPairs(run, records, flags.out_dir);
-    std::fprintf(stderr,
-                 "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
-                 "preview.png}: %zu occupied leaves\n",
-                 flags.out_dir.c_str(), summary.occupied_leaves);
-    std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
+    PrintMapClosing(summary, flags.out_dir);
     if (flags.json) {
       std::cout << json{{"scans", run.folder.scans.size()},
                         {"pairs", records.size()},

@@ -80,6 +80,7 @@ void PrintHuman(const RegistrationResult& r) {
             << "inlier_rmse " << r.inlier_rmse << " m\n"
             << "confidence  " << r.confidence << (r.doubtful ? " (doubtful)" : "") << "\n"
             << "attempts    " << r.attempts.size() << "\n"
+            << "answered_by " << RungName(r.answered_by) << "\n"
             << "evaluations " << r.evaluations << "\n"
             << "runtime     " << r.runtime_s << " s\n";
 }
@@ -92,8 +93,8 @@ int RunRegister(const RegisterFlags& flags) {
     const LoadedCloud target = LoadPointCloud(flags.target, load);
     std::optional<Transform> prior;
     if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
-    const ChosenSettings chosen =
-        ChooseSettingsForClouds({&source.points, &target.points}, source.format, config.seed);
+    const ChosenSettings chosen = ChooseSettingsForClouds(
+        {&source.points, &target.points}, source.format, config.seed, 2, config.threads);
     const std::vector<std::string> auto_fields = ApplyChosenSettings(chosen, config);
     ValidateConfig(config);
     if (!flags.quiet) {

@@ -25,12 +25,14 @@ std::string DescribeChosenSettings(const v1::ChosenSettings& s) {
   for (const std::string& field : s.auto_fields()) {
     automatic += (automatic.empty() ? "" : ", ") + field;
   }
+  // Jobs stored before the budget existed carry none.
+  const std::string budget = c.budget().empty() ? "" : ", budget " + c.budget();
   char text[512];
   std::snprintf(text, sizeof text,
-                "preset %s, %s, voxel %.3g m, refine voxel %.3g m, translation bounds "
+                "preset %s, %s%s, voxel %.3g m, refine voxel %.3g m, translation bounds "
                 "%.3g,%.3g,%.3g m, rotation bounds %.3g,%.3g,%.3g rad, map resolution %.3g m, "
                 "ray length %.3g m%s%s",
-                c.preset().c_str(), c.mode().c_str(), c.voxel(), c.refine_voxel(),
+                c.preset().c_str(), c.mode().c_str(), budget.c_str(), c.voxel(), c.refine_voxel(),
                 c.translation_bounds().x(), c.translation_bounds().y(), c.translation_bounds().z(),
                 c.rotation_bounds().x(), c.rotation_bounds().y(), c.rotation_bounds().z(),
                 s.map_resolution(), s.map_max_range(),
@@ -75,6 +77,7 @@ nlohmann::json PairToJson(const v1::PairResult& pair) {
       {"overlap", pair.has_overlap() ? nlohmann::json(pair.overlap()) : nlohmann::json(nullptr)},
       {"search_reach",
        pair.has_search_reach() ? nlohmann::json(pair.search_reach()) : nlohmann::json(nullptr)},
+      {"answered_by", rpc::AnsweredBy(pair)},
       {"evaluations", pair.evaluations()},
       {"runtime_s", pair.runtime_s()},
       {"finished_at", pair.finished_at()},

@@ -29,7 +29,8 @@ nlohmann::json JobToJson(const v1::Job& job);
 /// {"source", "target", "source_scan_id", "target_scan_id", "transform"
 ///  (T_target_source), "objective", "fitness", "inlier_rmse", "confidence",
 ///  "doubtful" (false when the daemon stored none), "overlap" and
-///  "search_reach" (null when unknown), "evaluations", "runtime_s",
+///  "search_reach" (null when unknown), "answered_by" (rpc::AnsweredBy),
+///  "evaluations" (of every rung), "runtime_s",
 ///  "finished_at", "seed", "in_graph"}.
 nlohmann::json PairToJson(const v1::PairResult& pair);
 

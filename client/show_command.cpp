@@ -2,8 +2,11 @@
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
+#include <vector>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/settings/rung_summary.hpp"
 #include "commands.hpp"
 #include "remote_json.hpp"
 #include "remote_options.hpp"
@@ -17,6 +20,39 @@ struct ShowFlags {
   std::string job_id;
   bool json = false;
 };
+
+// One line of the pair table; T_target_source summarised by its translation
+// and rotation angle.
+void PrintPair(const v1::PairResult& p) {
+  const Transform T = rpc::TransformFromProto(p.transform(), "pair.transform");
+  char overlap[32] = "-";  // unknown in results stored before it was computed
+  if (p.has_overlap()) std::snprintf(overlap, sizeof overlap, "%.3f", p.overlap());
+  std::printf("%6u %6u %8.3f %8s %10.3f %11.4f %8.4f %12s %7u %9.3f %9.2f %5s%s%s\n", p.source(),
+              p.target(), p.fitness(), overlap, p.confidence(), p.inlier_rmse(), p.objective(),
+              rpc::AnsweredBy(p).c_str(), p.evaluations(), TranslationNorm(T),
+              RotationAngle(T) * 180.0 / M_PI, FormatDuration(p.runtime_s()).c_str(),
+              p.doubtful() ? "  doubtful" : "", p.in_graph() ? "" : "  (not in graph)");
+}
+
+// The pair table, closed by the count of doubtful pairs and of the rung
+// that answered them.
+void PrintPairs(const v1::JobResults& results) {
+  std::printf("\n%6s %6s %8s %8s %10s %11s %8s %12s %7s %9s %9s %5s\n", "source", "target",
+              "fitness", "overlap", "confidence", "rmse_m", "objective", "answered_by", "evals",
+              "transl_m", "rot_deg", "time");
+  int doubtful = 0;
+  std::vector<Rung> answered_by;
+  for (const v1::PairResult& p : results.pairs()) {
+    PrintPair(p);
+    if (p.doubtful()) ++doubtful;
+    // A rung of a newer daemon that this client does not know goes uncounted.
+    if (const std::optional<Rung> rung = settings::RungFromName(rpc::AnsweredBy(p))) {
+      answered_by.push_back(*rung);
+    }
+  }
+  std::printf("\n%s\n", DoubtfulSummary(doubtful, results.pairs_size()).c_str());
+  std::printf("%s\n", settings::RungSummary(answered_by).c_str());
+}
 
 void PrintSummary(const v1::JobResults& results) {
   const v1::Job& job = results.job();
@@ -35,24 +71,7 @@ void PrintSummary(const v1::JobResults& results) {
   if (!job.error().empty()) std::printf("error       %s\n", job.error().c_str());
   if (job.has_settings())
     std::printf("settings    %s\n", DescribeChosenSettings(job.settings()).c_str());
-  if (results.pairs_size() == 0) return;
-  // T_target_source summarised by its translation and rotation angle.
-  std::printf("\n%6s %6s %8s %8s %10s %11s %8s %7s %9s %9s %5s\n", "source", "target", "fitness",
-              "overlap", "confidence", "rmse_m", "objective", "evals", "transl_m", "rot_deg",
-              "time");
-  int doubtful = 0;
-  for (const v1::PairResult& p : results.pairs()) {
-    const Transform T = rpc::TransformFromProto(p.transform(), "pair.transform");
-    char overlap[32] = "-";  // unknown in results stored before it was computed
-    if (p.has_overlap()) std::snprintf(overlap, sizeof overlap, "%.3f", p.overlap());
-    std::printf("%6u %6u %8.3f %8s %10.3f %11.4f %8.4f %7u %9.3f %9.2f %5s%s%s\n", p.source(),
-                p.target(), p.fitness(), overlap, p.confidence(), p.inlier_rmse(), p.objective(),
-                p.evaluations(), TranslationNorm(T), RotationAngle(T) * 180.0 / M_PI,
-                FormatDuration(p.runtime_s()).c_str(), p.doubtful() ? "  doubtful" : "",
-                p.in_graph() ? "" : "  (not in graph)");
-    if (p.doubtful()) ++doubtful;
-  }
-  std::printf("\n%s\n", DoubtfulSummary(doubtful, results.pairs_size()).c_str());
+  if (results.pairs_size() > 0) PrintPairs(results);
 }
 
 }  // namespace

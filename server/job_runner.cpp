@@ -142,9 +142,10 @@ class JobRun : public MapProgressSink {
     if (!r) throw std::logic_error("a finished pair is missing from the job's pair store");
     spdlog::info(
         "job {} pair {} done in {:.2f} s ({}/{}): fitness {:.3f}, confidence {:.3f}{}, "
-        "objective {:.4f} m",
+        "objective {:.4f} m, answered by {} in {} evaluations",
         job_.job_id(), PairName(pair.pair), r->runtime_s(), job_.pairs_done(), job_.pairs_total(),
-        r->fitness(), r->confidence(), r->doubtful() ? " (doubtful)" : "", r->objective());
+        r->fitness(), r->confidence(), r->doubtful() ? " (doubtful)" : "", r->objective(),
+        r->answered_by(), r->evaluations());
     Publish(&*r);
   }
 

@@ -90,16 +90,21 @@ JobStore::JobStore(const std::string& path) : db_(path) {
   db_.Exec("PRAGMA synchronous=FULL");
   db_.Exec("PRAGMA foreign_keys=ON");
   db_.Exec(kSchema);
-  AddUnendedRunsColumn();
+  // Columns added since the first release; older rows read their defaults:
+  // no unended runs, and answered by the full search, as every pair was
+  // before the escalation ladder.
+  AddMissingColumn("jobs", "unended_runs", "INTEGER NOT NULL DEFAULT 0");
+  AddMissingColumn("pair_results", "answered_by", "TEXT NOT NULL DEFAULT 'full-search'");
 }
 
-// Databases made before the column existed get it, counting 0.
-void JobStore::AddUnendedRunsColumn() {
-  auto columns = db_.Prepare("SELECT name FROM pragma_table_info('jobs')");
+void JobStore::AddMissingColumn(const std::string& table, const std::string& column,
+                                const std::string& definition) {
+  auto columns = db_.Prepare("SELECT name FROM pragma_table_info(?1)");
+  columns.Bind(1, table);
   while (columns.Step()) {
-    if (columns.ColumnText(0) == "unended_runs") return;
+    if (columns.ColumnText(0) == column) return;
   }
-  db_.Exec("ALTER TABLE jobs ADD COLUMN unended_runs INTEGER NOT NULL DEFAULT 0");
+  db_.Exec("ALTER TABLE " + table + " ADD COLUMN " + column + " " + definition);
 }
 
 int JobStore::BeginRun(const std::string& job_id) {
@@ -276,20 +281,21 @@ void JobStore::PutPair(const std::string& job_id, int plan_order, const v1::Pair
   std::lock_guard<std::mutex> lock(mutex_);
   db_.Prepare(
          "INSERT OR REPLACE INTO pair_results (job_id, source, target, plan_order, result, "
-         "information) VALUES (?1, ?2, ?3, ?4, ?5, ?6)")
+         "information, answered_by) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)")
       .Bind(1, job_id)
       .Bind(2, static_cast<int64_t>(result.source()))
       .Bind(3, static_cast<int64_t>(result.target()))
       .Bind(4, static_cast<int64_t>(plan_order))
       .BindBlob(5, Serialize(result))
       .BindBlob(6, InformationBytes(information))
+      .Bind(7, rpc::AnsweredBy(result))
       .Run();
 }
 
 std::vector<StoredPair> JobStore::GetPairs(const std::string& job_id) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto stmt = db_.Prepare(
-      "SELECT result, information FROM pair_results WHERE job_id = ?1 "
+      "SELECT result, information, answered_by FROM pair_results WHERE job_id = ?1 "
       "ORDER BY plan_order, source, target");
   stmt.Bind(1, job_id);
   std::vector<StoredPair> pairs;
@@ -297,6 +303,8 @@ std::vector<StoredPair> JobStore::GetPairs(const std::string& job_id) {
     StoredPair pair;
     pair.result = Parse<v1::PairResult>(stmt.ColumnBlob(0), "pair");
     pair.information = InformationFromBytes(stmt.ColumnBlob(1));
+    // The column speaks for rows stored before the result carried it.
+    pair.result.set_answered_by(stmt.ColumnText(2));
     pairs.push_back(std::move(pair));
   }
   return pairs;

@@ -1,9 +1,10 @@
 #pragma once
 // Durable state of the daemon in SQLite (WAL, synchronous=FULL): scans'
 // metadata, jobs with their normalised request and a snapshot of their
-// scans' metadata, finished pair results and trajectories. Every write is
-// its own transaction, so a daemon killed at any moment loses nothing it
-// acknowledged. Thread-safe: one connection behind a mutex.
+// scans' metadata, finished pair results (and the rung that answered each)
+// and trajectories. Every write is its own transaction, so a daemon killed
+// at any moment loses nothing it acknowledged. Thread-safe: one connection
+// behind a mutex.
 
 #include <cstdint>
 #include <mutex>
@@ -89,7 +90,10 @@ class JobStore {
   void Checkpoint();
 
  private:
-  void AddUnendedRunsColumn();
+  /// Adds `column` (its SQL `definition`) to `table` unless it is there:
+  /// databases written before it existed open with its default.
+  void AddMissingColumn(const std::string& table, const std::string& column,
+                        const std::string& definition);
   int ReadUnendedRuns(const std::string& job_id);
   std::optional<v1::Job> ReadJob(const std::string& job_id);
   void WriteJob(const v1::Job& job);

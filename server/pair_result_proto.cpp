@@ -21,6 +21,7 @@ namespace boicp::server {
   out.set_overlap(r.overlap);
   out.set_search_reach(r.search_reach);
   out.set_evaluations(static_cast<uint32_t>(r.evaluations));
+  out.set_answered_by(RungName(r.answered_by));
   out.set_runtime_s(r.runtime_s);
   out.set_finished_at(rpc::NowSeconds());
   out.set_seed(batch.seed);

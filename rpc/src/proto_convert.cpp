@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "boicp/registration/bo_icp.hpp"
 #include "boicp/rpc/sha256.hpp"
 
 namespace boicp::rpc {
@@ -142,6 +143,10 @@ void ValidateScanMetadata(const v1::ScanMetadata& metadata) {
   if (!metadata.sha256().empty() && !IsSha256Hex(metadata.sha256())) {
     throw InputError("metadata.sha256 must be 64 lowercase hex digits");
   }
+}
+
+std::string AnsweredBy(const v1::PairResult& pair) {
+  return pair.answered_by().empty() ? RungName(Rung::kFullSearch) : pair.answered_by();
 }
 
 bool IsTerminal(v1::JobState state) {

@@ -26,6 +26,7 @@ BoIcpConfig ConfigFromSettings(const RequestedSettings& settings) {
   if (settings.fixed_settings) config.automatic.clear();
   config.mode = ParseSearchMode(settings.mode);
   config.icp_objective = ParseIcpObjective(settings.icp_objective);
+  config.budget = ParseBudget(settings.budget);
   config.retry_when_doubtful = !settings.no_retry;
   config.seed = settings.seed;
   for (const SettingField& field : SettingSchema()) {
@@ -49,6 +50,7 @@ RequestedSettings SettingsFromConfig(const BoIcpConfig& config) {
   settings.preset = config.preset;
   settings.mode = SearchModeName(config.mode);
   settings.icp_objective = IcpObjectiveName(config.icp_objective);
+  settings.budget = BudgetName(config.budget);
   settings.seed = config.seed;
   settings.no_retry = !config.retry_when_doubtful;
   for (const SettingField& field : SettingSchema()) {

@@ -47,6 +47,10 @@ std::vector<SettingField> BuildSchema() {
        "ICP of the search evaluations: plane (point-to-plane, fewer iterations) or point (the "
        "paper's point-to-point)",
        nullptr, PlainBinding<std::string>{&RS::icp_objective}, kUnbounded},
+      {"budget", "--budget", nullptr, "budget", kReg, "budget", kEveryFrontEnd,
+       "auto (cheapest first: prior, features, short search, full search, retry, each only "
+       "while the answer is doubtful) or fixed (the paper's full search, then the retry)",
+       nullptr, PlainBinding<std::string>{&RS::budget}, kUnbounded},
       {"seed", "--seed", nullptr, "seed", kReg, "seed", kEveryFrontEnd,
        "Seed of every random choice; each pair's seed derives from it", nullptr,
        PlainBinding<uint64_t>{&RS::seed}, kUnbounded},

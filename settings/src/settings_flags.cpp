@@ -3,8 +3,29 @@
 #include <type_traits>
 
 #include "boicp/settings/triple_text.hpp"
+#include "boicp/util/types.hpp"
 
 namespace boicp::settings {
+namespace {
+
+// A word the engine does not know (--config, --mode, --budget, ...) is the
+// flag's error. Each word is tried alone on the defaults, so that the one
+// message names the flag as the user typed it and the words it allows.
+void CheckWords(const RequestedSettings& settings, Frontend frontend) {
+  for (const SettingField& field : SettingSchema()) {
+    const auto* binding = std::get_if<PlainBinding<std::string>>(&field.binding);
+    if (binding == nullptr || (field.frontends & frontend) == 0) continue;
+    RequestedSettings alone;
+    alone.*binding->requested = settings.*binding->requested;
+    try {
+      ConfigFromSettings(alone);
+    } catch (const InputError& e) {
+      throw InputError(std::string(FlagFor(field, frontend)) + ": " + e.what());
+    }
+  }
+}
+
+}  // namespace
 
 void AddSettingFlags(CLI::App& app, Frontend frontend, RequestedSettings& settings,
                      FlagTexts& texts) {
@@ -40,6 +61,7 @@ void ApplyFlagTexts(const FlagTexts& texts, Frontend frontend, RequestedSettings
     if (binding == nullptr) throw std::logic_error("no three-number setting '" + name + "'");
     settings.*binding->requested = ParseTriple(text, FlagFor(*field, frontend));
   }
+  CheckWords(settings, frontend);
 }
 
 }  // namespace boicp::settings

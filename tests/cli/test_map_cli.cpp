@@ -6,6 +6,7 @@
 #include <octomap/OcTree.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -111,6 +112,37 @@ class MapCli : public ::testing::Test {
   std::vector<Transform> truth_;  // T_world_scan of MakeDrive's scans
 };
 
+// The count per rung `map` closes with, from pairs.json's answered_by:
+// "31 prior, 5 features, 2 short, 1 full, 1 retry", rungs with none left out.
+std::string RungLine(const json& pairs) {
+  const std::pair<const char*, const char*> ladder[] = {{"prior", "prior"},
+                                                        {"features", "features"},
+                                                        {"short-search", "short"},
+                                                        {"full-search", "full"},
+                                                        {"retry", "retry"}};
+  std::string line;
+  for (const auto& [rung, word] : ladder) {
+    const auto count = std::count_if(pairs.begin(), pairs.end(),
+                                     [&](const json& p) { return p["answered_by"] == rung; });
+    if (count > 0) line += (line.empty() ? "" : ", ") + std::to_string(count) + " " + word;
+  }
+  return line;
+}
+
+// The last line of a command's output (which ends with a newline).
+std::string LastLine(const std::string& text) {
+  const std::string body = text.substr(0, text.size() - 1);
+  return body.substr(body.rfind('\n') + 1);
+}
+
+// "000002-000003.json" for a pairs.json entry.
+std::string PairFileName(const json& pair) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06d-%06d.json", pair["source"].get<int>(),
+                pair["target"].get<int>());
+  return name;
+}
+
 // Rewrites one pair file through `edit` (a JSON object in, one out).
 void EditPairFile(const fs::path& file, const std::function<void(json&)>& edit) {
   json j = json::parse(Slurp(file));
@@ -134,17 +166,27 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
     EXPECT_EQ(p["doubtful"].get<bool>(), p["confidence"].get<double>() < 0.5);
     EXPECT_GT(p["overlap"].get<double>(), 0.0);
     doubtful += p["doubtful"].get<bool>();
+    // Which rung answered, in pairs.json and in the pair's own file.
+    ASSERT_TRUE(p.contains("answered_by") && p["answered_by"].is_string()) << p.dump();
+    const json file = json::parse(Slurp(out / "pairs" / PairFileName(p)));
+    EXPECT_EQ(file["answered_by"], p["answered_by"]);
+    EXPECT_EQ(file["evaluations"], p["evaluations"]);
   }
   EXPECT_EQ(json::parse(first.out)["pairs_doubtful"], doubtful);
   EXPECT_THAT(first.err, HasSubstr(std::to_string(doubtful) + " of 3 pairs doubtful"));
+  // The closing line counts the rungs.
+  EXPECT_THAT(RungLine(pairs), ::testing::MatchesRegex("[0-9]+ [a-z]+(, [0-9]+ [a-z]+)*"));
+  EXPECT_EQ(LastLine(first.err), RungLine(pairs)) << first.err;
 
   // Files written before the marks existed load as trusted, overlap and
-  // reach unknown; a file marked doubtful is counted as such.
+  // reach unknown, answered by the full search; a file marked doubtful is
+  // counted as such.
   for (const char* name : {"000000-000001.json", "000001-000002.json"}) {
     EditPairFile(out / "pairs" / name, [](json& j) {
       j.erase("doubtful");
       j.erase("overlap");
       j.erase("search_reach");
+      j.erase("answered_by");
     });
   }
   EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) {
@@ -161,12 +203,17 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   EXPECT_EQ(pairs[0]["doubtful"], false);
   EXPECT_TRUE(pairs[0]["overlap"].is_null());
   EXPECT_TRUE(pairs[0]["search_reach"].is_null());
+  EXPECT_EQ(pairs[0]["answered_by"], "full-search");
+  EXPECT_EQ(pairs[1]["answered_by"], "full-search");
   EXPECT_EQ(pairs[2]["doubtful"], true);
+  EXPECT_EQ(LastLine(again.err), RungLine(pairs)) << again.err;
+  EXPECT_THAT(RungLine(pairs), HasSubstr("full")) << again.err;
 }
 
 // A pair file's config object as it was written before it followed the
 // settings schema: three settings under other names, the retry switch the
-// other way round, engine constants no front end sets, and no ICP objective.
+// other way round, engine constants no front end sets, and no ICP objective
+// or budget.
 json OlderPairConfig(const json& config) {
   json old = config;
   const std::pair<const char*, const char*> renamed[] = {
@@ -180,6 +227,7 @@ json OlderPairConfig(const json& config) {
   old["retry_when_doubtful"] = !old.at("no_retry").get<bool>();
   old.erase("no_retry");
   old.erase("icp_objective");  // point-to-point was the only one
+  old.erase("budget");         // the full search was the only one
   old["finish_icp_iterations"] = 5;
   old["refine_max_iterations"] = 60;
   old["refine_candidates"] = 3;
@@ -191,8 +239,8 @@ json OlderPairConfig(const json& config) {
 TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
   const fs::path scans = MakeDrive(4);
   const fs::path out = dir_ / "out";
-  const std::string args =
-      "map " + scans.string() + " -o " + out.string() + Quick() + " --json --icp-objective point";
+  const std::string args = "map " + scans.string() + " -o " + out.string() + Quick() +
+                           " --json --icp-objective point --budget fixed";
   const RunResult first = Run(args);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   const std::string trajectory = Slurp(out / "trajectory.kitti");
@@ -320,6 +368,8 @@ TEST_F(MapCli, BadInputGivesOneLineErrorExitCode2AndNoMap) {
       {"map " + scans.string() + out + " --count 1", "at least 2 scans"},
       {"map " + scans.string() + out + " --resolution -1", "resolution"},
       {"map " + scans.string() + out + " --config Z", "Z"},
+      {"map " + scans.string() + out + " --budget nope",
+       "--budget: unknown budget 'nope' (expected auto or fixed)"},
       {"preview " + (dir_ / "not_a_map.bt").string() + " -o " + (dir_ / "p.png").string(),
        "not an OctoMap file"},
   };
@@ -488,6 +538,8 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
       const auto local = local_pairs.find(key);
       if (local == local_pairs.end()) continue;  // a keyframe probe only one side ran ahead to
       EXPECT_EQ(local->second["seed"].get<uint64_t>(), remote.seed());
+      EXPECT_EQ(local->second["answered_by"], remote.answered_by());
+      EXPECT_EQ(local->second["evaluations"], remote.evaluations());
       for (int k = 0; k < 16; ++k) {
         EXPECT_NEAR(local->second["transform"][k / 4][k % 4].get<double>(), remote.transform().m(k),
                     1e-12)

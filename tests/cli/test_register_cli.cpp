@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -39,15 +40,33 @@ class Cli : public ::testing::Test {
   fs::path dir_;
 };
 
+// The rungs of the ladder, as answered_by names them.
+const std::set<std::string> kRungs = {"prior", "features", "short-search", "full-search", "retry"};
+
+// The attempts of a `register --json` answer: exactly one is kept, its fit
+// is the answer's, and the evaluations add up to the answer's.
+void ExpectAttemptsAddUp(const nlohmann::json& j) {
+  int kept = 0, evaluations = 0;
+  for (const nlohmann::json& attempt : j["attempts"]) {
+    evaluations += attempt["evaluations"].get<int>();
+    if (!attempt["kept"].get<bool>()) continue;
+    ++kept;
+    EXPECT_EQ(attempt["fitness"], j["fitness"]);
+  }
+  EXPECT_EQ(kept, 1);
+  EXPECT_EQ(evaluations, j["evaluations"]);
+}
+
 TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
-  const RunResult r = Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
-                          (dir_ / "target.xyz").string() +
-                          " --config A --seed 3 --rotation-bounds 0.2,0.2,pi --json");
+  const std::string args = "register --source " + (dir_ / "source.xyz").string() + " --target " +
+                           (dir_ / "target.xyz").string() +
+                           " --config A --seed 3 --rotation-bounds 0.2,0.2,pi";
+  const RunResult r = Run(args + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);  // throws if anything else is on stdout
   for (const char* key : {"transform", "objective", "fitness", "inlier_rmse", "confidence",
-                          "evaluations", "runtime_s", "config"}) {
+                          "answered_by", "evaluations", "runtime_s", "config"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   std::ifstream truth_file(dir_ / "truth.txt");
@@ -59,6 +78,7 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
       EXPECT_NEAR(j["transform"][i][k].get<double>(), truth[4 * i + k], 0.02);
   }
   EXPECT_EQ(j["config"]["preset"], "A");
+  EXPECT_EQ(j["config"]["budget"], "auto");
   // The rotation box was given ("pi" is pi); the rest came from the clouds.
   EXPECT_EQ(j["config"]["rotation_bounds"][2].get<double>(), M_PI);
   EXPECT_EQ(j["auto"], nlohmann::json({"voxel", "refine_voxel", "objective_truncation",
@@ -70,27 +90,50 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   // The answer lies inside its search box.
   EXPECT_GE(j["search_reach"].get<double>(), 0.0);
   EXPECT_LE(j["search_reach"].get<double>(), 1.0);
-  // The first search is nested, (10 + 20) evaluations per stage; a doubtful
-  // one is tried again. The answer is the one attempt kept.
+  // Some rung of the ladder answered: one attempt kept.
+  EXPECT_EQ(kRungs.count(j["answered_by"].get<std::string>()), 1u) << j["answered_by"];
+  ASSERT_GE(j["attempts"].size(), 1u);
+  ExpectAttemptsAddUp(j);
+
+  // The plain text says it too.
+  const RunResult text = Run(args + " -q");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_THAT(text.out, HasSubstr("answered_by " + j["answered_by"].get<std::string>() + "\n"));
+  EXPECT_THAT(text.out, HasSubstr("evaluations " + std::to_string(j["evaluations"].get<int>())));
+}
+
+// The paper's search, as before the ladder: nested, (10 + 20) evaluations a
+// stage, and only the retry of a doubtful answer after it.
+TEST_F(Cli, FixedBudgetRunsThePapersSearch) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const RunResult r =
+      Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
+          (dir_ / "target.xyz").string() +
+          " --config A --seed 3 --rotation-bounds 0.2,0.2,pi --budget fixed --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["config"]["budget"], "fixed");
   ASSERT_GE(j["attempts"].size(), 1u);
   EXPECT_EQ(j["attempts"][0]["kind"], "search");
   EXPECT_EQ(j["attempts"][0]["mode"], "nested");
   EXPECT_EQ(j["attempts"][0]["evaluations"], 60);
-  int kept = 0;
   for (const nlohmann::json& attempt : j["attempts"]) {
-    if (!attempt["kept"].get<bool>()) continue;
-    ++kept;
-    EXPECT_EQ(attempt["evaluations"], j["evaluations"]);
-    EXPECT_EQ(attempt["fitness"], j["fitness"]);
+    EXPECT_THAT(attempt["kind"].get<std::string>(), ::testing::AnyOf("search", "wider-refinement"));
   }
-  EXPECT_EQ(kept, 1);
+  const std::string rung = j["answered_by"];
+  EXPECT_THAT(rung, ::testing::AnyOf("full-search", "retry"));
+  if (j["attempts"].size() == 1) {
+    EXPECT_EQ(rung, "full-search");
+  }
+  ExpectAttemptsAddUp(j);
 }
 
 TEST_F(Cli, FixedSettingsAndNoRetry) {
   ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
   const RunResult r = Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
                           (dir_ / "target.xyz").string() +
-                          " --config A --seed 3 --iterations 5 --fixed-settings --no-retry --json");
+                          " --config A --seed 3 --iterations 5 --fixed-settings --no-retry"
+                          " --budget fixed --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["auto"].empty());
@@ -101,7 +144,9 @@ TEST_F(Cli, FixedSettingsAndNoRetry) {
   EXPECT_DOUBLE_EQ(j["config"]["max_correspondence"].get<double>(), 3.0 * 0.7);
   EXPECT_DOUBLE_EQ(j["config"]["objective_truncation"].get<double>(), 1.5 * 0.7);
   EXPECT_DOUBLE_EQ(j["config"]["refine_voxel"].get<double>(), 0.7 / 4.0);
+  // The fixed budget without its retry: the one search answers.
   EXPECT_EQ(j["attempts"].size(), 1u);
+  EXPECT_EQ(j["answered_by"], "full-search");
 }
 
 TEST_F(Cli, BadInputGivesOneLineErrorAndExitCode2) {
@@ -120,6 +165,8 @@ TEST_F(Cli, BadInputGivesOneLineErrorAndExitCode2) {
       {pair + " --translation-bounds 1,2", "--translation-bounds"},
       {pair + " --rotation-bounds 0.2,0.2,tau", "--rotation-bounds"},
       {pair + " --config Z", "preset"},
+      {pair + " --budget nope", "--budget: unknown budget 'nope' (expected auto or fixed)"},
+      {pair + " --mode nope", "--mode: unknown search mode 'nope' (expected nested or 6dof)"},
       {pair + " --max-range 0.01", "points after cropping"},
       {pair + " --prior /nonexistent_prior.txt", "nonexistent_prior"},
   };
@@ -144,7 +191,7 @@ TEST_F(Cli, MissingRequiredFlagAndHelp) {
   for (const char* flag :
        {"--voxel", "--translation-bounds", "--rotation-bounds", "--format", "--intrinsics",
         "--intrinsics-file", "--depth-scale", "--prior", "--config", "--mode", "--seed", "--json",
-        "--fixed-settings", "--no-retry"}) {
+        "--fixed-settings", "--no-retry", "--budget"}) {
     EXPECT_THAT(help.out, HasSubstr(flag));
   }
 }

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -174,8 +175,9 @@ const char* kQuick =
 TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   StartDaemon();
   const std::vector<boicp::Transform> truth = WriteDrive(dir_ / "drive", 4, 11);
-  const std::string job =
-      SubmitAndWait((dir_ / "drive").string() + kQuick + " --resolution 0.3 --label drive4");
+  // The fixed budget reaches the daemon's job: the paper's search answers.
+  const std::string job = SubmitAndWait((dir_ / "drive").string() + kQuick +
+                                        " --resolution 0.3 --label drive4 --budget fixed");
 
   const RunResult show = Run("show " + job + " --json" + server_);
   ASSERT_EQ(show.exit_code, 0) << show.err;
@@ -189,11 +191,13 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_EQ(used["random_samples"], 4);
   EXPECT_EQ(used["rotation_bounds"], nlohmann::json({0.2, 0.2, M_PI}));
   EXPECT_EQ(used["no_retry"], false);
+  EXPECT_EQ(used["budget"], "fixed");
   EXPECT_GT(used["voxel"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(used["map_resolution"].get<double>(), 0.3);
   ASSERT_EQ(j["pairs"].size(), 3u);
   ASSERT_EQ(j["trajectory"].size(), 4u);
   int doubtful = 0;
+  std::map<std::string, int> rungs;  // the closing line's words
   for (const auto& pair : j["pairs"]) {
     ASSERT_TRUE(pair["doubtful"].is_boolean()) << pair.dump();
     EXPECT_EQ(pair["doubtful"].get<bool>(), pair["confidence"].get<double>() < 0.5);
@@ -201,6 +205,9 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
     EXPECT_GT(pair["overlap"].get<double>(), 0.0);
     ASSERT_TRUE(pair["search_reach"].is_number()) << pair.dump();
     doubtful += pair["doubtful"].get<bool>();
+    EXPECT_THAT(pair["answered_by"].get<std::string>(), ::testing::AnyOf("full-search", "retry"));
+    EXPECT_GT(pair["evaluations"].get<int>(), 0);
+    rungs[pair["answered_by"] == "retry" ? "retry" : "full"] += 1;
   }
   EXPECT_EQ(j["pairs_doubtful"], doubtful);
   for (const auto& pair : j["pairs"]) {
@@ -218,6 +225,15 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   ASSERT_EQ(human.exit_code, 0) << human.err;
   EXPECT_THAT(human.out, HasSubstr("succeeded"));
   EXPECT_THAT(human.out, HasSubstr(std::to_string(doubtful) + " of 3 pairs doubtful"));
+  EXPECT_THAT(human.out, HasSubstr("budget fixed"));
+  EXPECT_THAT(human.out, HasSubstr("answered_by"));
+  // It closes with the count per rung, in ladder order.
+  std::string closing;
+  for (const char* word : {"full", "retry"}) {
+    if (rungs[word] == 0) continue;
+    closing += (closing.empty() ? "" : ", ") + std::to_string(rungs[word]) + " " + word;
+  }
+  EXPECT_EQ(Lines(human.out).back(), closing) << human.out;
 
   // The address may come from BOICP_SERVER instead of --server.
   const RunResult jobs = Run("jobs --json", "BOICP_SERVER=" + daemon_->address());
@@ -323,6 +339,8 @@ TEST_F(RemoteCli, UnknownJobAndBadInputGiveOneLineErrors) {
            (dir_ / "pairs.txt").string(),
        "do not connect scan 2"},
       {"submit " + (dir_ / "good").string() + " --config Z", "unknown preset 'Z'"},
+      {"submit " + (dir_ / "good").string() + " --budget nope",
+       "--budget: unknown budget 'nope' (expected auto or fixed)"},
       {"submit " + (dir_ / "good").string() + " --rotation-bounds 1,2", "--rotation-bounds"},
       {"submit " + (dir_ / "good").string() + " --pairing sideways", "--pairing"},
       {"export job-000001 --format gif", "--format"},

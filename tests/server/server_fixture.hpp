@@ -22,8 +22,8 @@ namespace v1 = ::boicp::v1;
 /// rotation bounds. The scans overlap so much that this is still exact.
 v1::SubmitBatchRequest QuickBatch(const std::vector<std::string>& scan_ids, uint64_t seed = 3);
 
-/// QuickBatch with the full preset C search: seconds a pair, so a test can
-/// act while it runs.
+/// QuickBatch with the full preset C search (budget fixed): seconds a pair,
+/// so a test can act while it runs.
 v1::SubmitBatchRequest SlowBatch(const std::vector<std::string>& scan_ids);
 
 /// Uploads raw messages: `metadata`, then `chunks` (stopping at the first

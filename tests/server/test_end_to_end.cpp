@@ -153,6 +153,7 @@ TEST_F(EndToEnd, BatchToOctomapAndTrajectory) {
   ASSERT_EQ(results.pairs_size(), n - 1);
   ASSERT_EQ(results.trajectory_size(), n);
   uint32_t doubtful = 0;
+  const std::set<std::string> rungs = {"prior", "features", "short-search", "full-search", "retry"};
   for (const v1::PairResult& pair : results.pairs()) {
     EXPECT_GT(pair.fitness(), 0.5);
     EXPECT_EQ(pair.transform().m_size(), 16);
@@ -160,8 +161,18 @@ TEST_F(EndToEnd, BatchToOctomapAndTrajectory) {
     EXPECT_EQ(pair.doubtful(), pair.confidence() < 0.5);
     EXPECT_GT(pair.overlap(), 0.0);
     doubtful += pair.doubtful();
+    // Which rung of the (default, auto) ladder answered, as stored and as
+    // streamed when the pair finished.
+    EXPECT_EQ(rungs.count(pair.answered_by()), 1u) << "'" << pair.answered_by() << "'";
+    EXPECT_GT(pair.evaluations(), 0u);
+    for (const v1::PairResult& event : streamed) {
+      if (event.source() != pair.source() || event.target() != pair.target()) continue;
+      EXPECT_EQ(event.answered_by(), pair.answered_by());
+      EXPECT_EQ(event.evaluations(), pair.evaluations());
+    }
   }
   EXPECT_EQ(done.pairs_doubtful(), doubtful);
+  EXPECT_EQ(done.settings().config().budget(), "auto");
 
   const fs::path bt = dir_ / "map.bt", tum = dir_ / "trajectory.tum", kit = dir_ / "traj.kitti";
   EXPECT_GT(client.ExportToFile(done.job_id(), v1::EXPORT_FORMAT_OCTOMAP_BT, bt.string()), 0u);

@@ -12,9 +12,18 @@
 
 namespace boicp::settings {
 
+/// A word setting's value, other than its default (--config: the preset).
+inline std::string ExampleWord(const std::string& flag) {
+  if (flag == "--mode") return "6dof";
+  if (flag == "--icp-objective") return "point";
+  if (flag == "--budget") return "fixed";
+  return "B";
+}
+
 /// The command line that gives every setting of `frontend` a value:
-/// preset B, mode 6dof, switches on, the n-th number field n + 0.25 (the
-/// refinement voxel 0.25, counts n + 7), bounds "0.25,0.5,1.25".
+/// preset B, mode 6dof, ICP objective point, budget fixed, switches on,
+/// the n-th number field n + 0.25 (the refinement voxel 0.25, counts n + 7),
+/// bounds "0.25,0.5,1.25".
 inline std::vector<std::string> ExampleArguments(Frontend frontend) {
   std::vector<std::string> args = {"test"};
   int n = 0;
@@ -31,7 +40,7 @@ inline std::vector<std::string> ExampleArguments(Frontend frontend) {
           }
           std::string value;
           if constexpr (std::is_same_v<Binding, PlainBinding<std::string>>) {
-            value = flag == "--mode" ? "6dof" : flag == "--icp-objective" ? "point" : "B";
+            value = ExampleWord(flag);
           } else if constexpr (std::is_same_v<Binding, OptionalBinding<double>>) {
             // The refinement voxel may not exceed the search voxel.
             value = flag == "--refine-voxel" ? "0.25" : std::to_string(n) + ".25";

@@ -240,6 +240,37 @@ TEST(BayesOptTest, StopRequestThrowsCancelledBeforeTheNextEvaluation) {
   EXPECT_EQ(evaluations, 13);
 }
 
+// A search ended early by `enough` and then resumed spends the whole budget
+// once: the resumed run repeats none of the evaluations it was handed.
+TEST(BayesOptTest, AnEarlyEndIsResumedToTheWholeBudgetWithoutRepeats) {
+  const BayesOptOptions options = Budget(6, 10);
+  const std::vector<bool> periodic = {false, false};
+  int calls = 0;
+  const BoundedObjective f = [&](const Eigen::VectorXd& x, double) {
+    ++calls;
+    return BraninUnit(x);
+  };
+  BayesOptHooks hooks;
+  hooks.enough = [](const std::vector<BayesOptSample>& history) { return history.size() >= 8; };
+  const BayesOptResult early = MinimiseBayesOpt(f, periodic, options, 7, {}, hooks);
+  EXPECT_EQ(early.history.size(), 8u);  // the design, then one round of two
+  EXPECT_EQ(calls, 8);
+
+  BayesOptHooks rest;
+  rest.resume = early.history;
+  const BayesOptResult whole = MinimiseBayesOpt(f, periodic, options, 7, {}, rest);
+  ASSERT_EQ(whole.history.size(), 16u);
+  EXPECT_EQ(calls, 16);
+  for (size_t i = 0; i < early.history.size(); ++i) {
+    EXPECT_TRUE(whole.history[i].x == early.history[i].x) << "evaluation " << i;
+  }
+  EXPECT_LE(whole.best_y, early.best_y);
+
+  // `enough` is asked only once the initial design is complete.
+  hooks.enough = [](const std::vector<BayesOptSample>&) { return true; };
+  EXPECT_EQ(MinimiseBayesOpt(f, periodic, options, 7, {}, hooks).history.size(), 6u);
+}
+
 TEST(BayesOptTest, InvalidOptionsThrowInputError) {
   const UnitObjective f = [](const Eigen::VectorXd& x) { return x.squaredNorm(); };
   const std::vector<bool> two = {false, false};

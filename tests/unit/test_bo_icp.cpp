@@ -37,6 +37,7 @@ BoIcpConfig SmallConfig(SearchMode mode) {
   config.rotation_bounds = Eigen::Vector3d(0.2, 0.2, M_PI);  // a car: any yaw, small roll and pitch
   config.evaluation_points = 1000;
   config.seed = 5;
+  config.budget = Budget::kFixed;  // the search itself, as the paper runs it
   return config;
 }
 
@@ -120,10 +121,8 @@ TEST(BoIcp, SameSeedSameAnswerAndThreadCountDoesNotMatter) {
   }
 }
 
-// Two unrelated blobs of noise: no answer fits, so the first search is
-// doubtful. More of its ends are compared at the finest level, and when that
-// is still doubtful a second search runs in 6 DOF with another seed.
-TEST(BoIcp, DoubtfulAnswerIsTriedAgainWiderThenInSixDof) {
+// Two unrelated blobs of noise, each 10 m across.
+std::pair<Points, Points> UnrelatedBlobs() {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-5.0, 5.0);
   Points source, target;
@@ -131,6 +130,14 @@ TEST(BoIcp, DoubtfulAnswerIsTriedAgainWiderThenInSixDof) {
     source.emplace_back(u(rng), u(rng), u(rng));
     target.emplace_back(u(rng), u(rng), u(rng));
   }
+  return {source, target};
+}
+
+// Two unrelated blobs of noise: no answer fits, so the first search is
+// doubtful. More of its ends are compared at the finest level, and when that
+// is still doubtful a second search runs in 6 DOF with another seed.
+TEST(BoIcp, DoubtfulAnswerIsTriedAgainWiderThenInSixDof) {
+  const auto [source, target] = UnrelatedBlobs();
   BoIcpConfig config = SmallConfig(SearchMode::kNested);
   config.iterations = 3;
   config.retry_voxel = 2.0 * config.voxel;
@@ -226,6 +233,118 @@ TEST(BoIcp, LocalIcpHookReplacesEveryEvaluationsIcp) {
   const RegistrationResult identity =
       RegisterPair(pair.source, pair.target, config, std::nullopt, callbacks);
   for (const Evaluation& e : identity.history) EXPECT_TRUE(e.result == e.initial);
+}
+
+TEST(BoIcp, FixedBudgetIsAnsweredByTheFullSearch) {
+  const StreetPair pair = MakeStreetPair(2.3);
+  const RegistrationResult result =
+      RegisterPair(pair.source, pair.target, SmallConfig(SearchMode::kNested));
+  EXPECT_EQ(result.answered_by, Rung::kFullSearch);
+  ASSERT_EQ(result.attempts.size(), 1u);
+  EXPECT_EQ(result.attempts[0].kind, AttemptKind::kSearch);
+  EXPECT_EQ(result.evaluations, SmallConfig(SearchMode::kNested).random_samples * 2 +
+                                    SmallConfig(SearchMode::kNested).iterations * 2);
+}
+
+BoIcpConfig LadderConfig() {
+  BoIcpConfig config = SmallConfig(SearchMode::kNested);
+  config.budget = Budget::kAuto;
+  return config;
+}
+
+// Every rung's ICP runs are counted, exactly one attempt is kept, and it is
+// the most confident one.
+void ExpectConsistentLadder(const RegistrationResult& result) {
+  int evaluations = 0, kept = 0;
+  for (const Attempt& a : result.attempts) {
+    evaluations += a.evaluations;
+    kept += a.kept ? 1 : 0;
+    EXPECT_LE(a.confidence, result.confidence);
+    if (a.kept) {
+      EXPECT_EQ(a.confidence, result.confidence);
+    }
+  }
+  EXPECT_EQ(result.evaluations, evaluations);
+  EXPECT_EQ(kept, 1);
+}
+
+// A street turned by 132 degrees is beyond ICP from identity; the feature
+// rung finds it with a few ICP runs where the search spends a hundred.
+TEST(BoIcpLadder, FeaturesAnswerALargeTurnWithoutASearch) {
+  const StreetPair pair = MakeStreetPair(2.3);
+  const RegistrationResult result = RegisterPair(pair.source, pair.target, LadderConfig());
+  EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
+  EXPECT_LT(TranslationErrorM(result.transform, pair.truth), 0.1);
+  EXPECT_FALSE(result.doubtful);
+  EXPECT_EQ(result.answered_by, Rung::kFeatures);
+  ASSERT_EQ(result.attempts.size(), 1u);
+  EXPECT_EQ(result.attempts[0].kind, AttemptKind::kFeatures);
+  EXPECT_LT(result.evaluations, 10);
+  ExpectConsistentLadder(result);
+}
+
+// A guess inside the basin (a drive's consecutive scans from identity) is
+// answered by the prior rung, and a guess does not move the search box.
+TEST(BoIcpLadder, AGoodGuessIsAnsweredByThePriorRung) {
+  const StreetPair pair = MakeStreetPair(0.05);
+  const RegistrationResult result = RegisterPair(pair.source, pair.target, LadderConfig(),
+                                                 std::nullopt, {}, Transform::Identity());
+  EXPECT_EQ(result.answered_by, Rung::kPrior);
+  EXPECT_LT(RotationErrorDeg(result.transform, pair.truth), 1.0);
+  EXPECT_LT(TranslationErrorM(result.transform, pair.truth), 0.1);
+  ASSERT_EQ(result.attempts.size(), 1u);
+  EXPECT_EQ(result.attempts[0].kind, AttemptKind::kPrior);
+  ExpectConsistentLadder(result);
+}
+
+// Nothing fits two unrelated blobs: every rung runs, the short search is
+// continued rather than restarted, the retry searches in 6 DOF with another
+// seed, and the answer stays doubtful.
+TEST(BoIcpLadder, ADoubtfulPairClimbsEveryRung) {
+  const auto [source, target] = UnrelatedBlobs();
+  BoIcpConfig config = LadderConfig();
+  config.iterations = 4;
+  config.retry_when_doubtful = true;
+  const RegistrationResult result =
+      RegisterPair(source, target, config, std::nullopt, {}, Transform::Identity());
+  EXPECT_TRUE(result.doubtful);
+  std::vector<AttemptKind> kinds;
+  for (const Attempt& a : result.attempts) kinds.push_back(a.kind);
+  ASSERT_EQ(kinds, (std::vector<AttemptKind>{AttemptKind::kPrior, AttemptKind::kFeatures,
+                                             AttemptKind::kShortSearch, AttemptKind::kSearch,
+                                             AttemptKind::kSearch}));
+  const Attempt& short_search = result.attempts[2];
+  const Attempt& rest = result.attempts[3];
+  const Attempt& retry = result.attempts[4];
+  // The continued search repeats none of the short one's rotation stage; its
+  // translation stage starts again only where the best rotation moved its box.
+  const int stage_budget = config.random_samples + config.iterations;
+  EXPECT_GE(short_search.evaluations + rest.evaluations, 2 * stage_budget);
+  EXPECT_LT(rest.evaluations, 2 * stage_budget);
+  EXPECT_EQ(retry.mode, SearchMode::kSixDof);
+  EXPECT_NE(retry.seed, config.seed);
+  EXPECT_EQ(retry.evaluations, 2 * (config.random_samples + config.iterations));
+  ExpectConsistentLadder(result);
+
+  // In one 6-DOF stage the short and the continued search spend its budget once.
+  config.retry_when_doubtful = false;
+  config.mode = SearchMode::kSixDof;
+  const RegistrationResult six_dof = RegisterPair(source, target, config);
+  ASSERT_EQ(six_dof.attempts.size(), 3u);
+  EXPECT_EQ(six_dof.attempts[1].evaluations + six_dof.attempts[2].evaluations, stage_budget);
+  EXPECT_EQ(six_dof.attempts.back().kind, AttemptKind::kSearch);
+}
+
+TEST(BoIcpLadder, ThreadCountDoesNotChangeTheAnswer) {
+  const StreetPair pair = MakeStreetPair(2.3);
+  BoIcpConfig config = LadderConfig();
+  const RegistrationResult a = RegisterPair(pair.source, pair.target, config);
+  config.threads = 2;
+  const RegistrationResult b = RegisterPair(pair.source, pair.target, config);
+  EXPECT_TRUE(a.transform == b.transform);
+  EXPECT_EQ(a.confidence, b.confidence);
+  EXPECT_EQ(a.answered_by, b.answered_by);
+  EXPECT_EQ(a.evaluations, b.evaluations);
 }
 
 TEST(BoIcp, StopRequestCancels) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/confidence.hpp"
 
 namespace boicp {
@@ -14,6 +15,29 @@ ConfidenceFeatures Features(double fitness, double margin, double resolution_deg
   f.margin = margin;
   f.resolution_deg = resolution_deg;
   return f;
+}
+
+// Confidence rises with every inlier, whatever the margin and resolution.
+TEST(Confidence, MonotoneInFitness) {
+  for (double margin : {0.0, 0.1, 1.0}) {
+    for (double resolution : {0.1, 1.0}) {
+      double previous = 0.0;
+      for (double fitness = 0.0; fitness <= 1.0; fitness += 0.05) {
+        const double c = Confidence(Features(fitness, margin, resolution));
+        EXPECT_GT(c, previous) << fitness << " " << margin << " " << resolution;
+        previous = c;
+      }
+    }
+  }
+}
+
+// No inliers (RefineCoarseToFine then reports no margin either) is never
+// trusted, at any resolution; nor is a weak fit without a runner-up.
+TEST(Confidence, NoInliersOrAWeakLoneAnswerIsDoubtful) {
+  for (double resolution : {0.05, 0.5, 2.0}) {
+    EXPECT_LT(Confidence(Features(0.0, 0.0, resolution)), kDoubtfulBelow);
+    EXPECT_LT(Confidence(Features(0.2, 0.0, resolution)), kDoubtfulBelow);
+  }
 }
 
 TEST(Confidence, MoreInliersAndAWiderMarginAreMoreCertain) {

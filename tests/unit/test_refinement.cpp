@@ -93,6 +93,35 @@ TEST(Refinement, TheStartThatFitsBestWinsWhateverItsPlaceInTheList) {
   EXPECT_THROW(RefineCoarseToFine({}, pair, config), InputError);
 }
 
+// The margin compares the answer with another basin; where nothing was
+// compared, or nothing fits, there is no margin to claim.
+TEST(Refinement, MarginNeedsARunnerUpAndInliers) {
+  const KnownPair known = MakeKnownPair();
+  const PreparedPair& pair = known.pair;
+  const BoIcpConfig& config = known.config;
+  const Transform wrong = PoseFromYawTranslation(M_PI, {3.0, 1.0, 0.0});
+
+  // A single start: nothing to compare with, however well it fits.
+  const RefinedAlignment alone = RefineCoarseToFine({Transform::Identity()}, pair, config);
+  EXPECT_GT(alone.score.fitness, 0.99);
+  EXPECT_EQ(alone.margin, 0.0);
+
+  // A clearly worse basin beside it: the margin is large but measured.
+  const RefinedAlignment compared =
+      RefineCoarseToFine({Transform::Identity(), wrong}, pair, config);
+  EXPECT_GT(compared.margin, 0.5);
+  EXPECT_LT(compared.margin, 1.0);
+
+  // Starts 100 m away from every point: no inliers, no margin.
+  Transform far = Transform::Identity();
+  far(0, 3) = 100.0;
+  Transform farther = far;
+  farther(1, 3) = 100.0;
+  const RefinedAlignment nothing = RefineCoarseToFine({far, farther}, pair, config);
+  EXPECT_EQ(nothing.score.fitness, 0.0);
+  EXPECT_EQ(nothing.margin, 0.0);
+}
+
 TEST(Refinement, RmsRadiusOfACubesCornersIsItsHalfDiagonal) {
   Points corners;
   for (double x : {-1.0, 1.0})

@@ -67,6 +67,24 @@ TEST(SettingsProto, ProtoToConfigToProto) {
       << "sent " << sent.ShortDebugString() << "\nreported " << reported.ShortDebugString();
 }
 
+TEST(SettingsProto, TheBudgetCrossesTheApi) {
+  RequestedSettings given;
+  given.budget = "fixed";
+  const v1::RegistrationConfig sent = rpc::RegistrationConfigToProto(given);
+  EXPECT_EQ(sent.budget(), "fixed");
+  EXPECT_EQ(ConfigFromSettings(rpc::SettingsFromProto(sent, {})).budget, Budget::kFixed);
+  // An empty budget (a client from before it existed) is auto.
+  EXPECT_EQ(ConfigFromSettings(rpc::SettingsFromProto({}, {})).budget, Budget::kAuto);
+  v1::RegistrationConfig bad;
+  bad.set_budget("nope");
+  try {
+    ConfigFromSettings(rpc::SettingsFromProto(bad, {}));
+    FAIL() << "budget nope accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "unknown budget 'nope' (expected auto or fixed)");
+  }
+}
+
 TEST(SettingsProto, UnsetFieldsStayUnsetAndBadValuesNameTheField) {
   const v1::RegistrationConfig empty = rpc::RegistrationConfigToProto(RequestedSettings());
   EXPECT_FALSE(empty.has_voxel());

@@ -45,6 +45,7 @@ TEST(SettingSchema, EveryRegisterFlagReachesTheConfigAndSurvivesJson) {
   const BoIcpConfig config = ConfigFromSettings(given);
   EXPECT_EQ(config.preset, "B");
   EXPECT_EQ(config.mode, SearchMode::kSixDof);
+  EXPECT_EQ(config.budget, Budget::kFixed);
   EXPECT_FALSE(config.retry_when_doubtful);
   EXPECT_TRUE(config.automatic.empty());
   for (const SettingField& field : SettingSchema()) {
@@ -95,6 +96,7 @@ TEST(SettingSchema, ConfigAsUsedNamesEveryRegistrationSettingAndReadsBack) {
   EXPECT_EQ(keys, expected);
   EXPECT_EQ(used["preset"], "B");
   EXPECT_EQ(used["no_retry"], true);
+  EXPECT_EQ(used["budget"], "fixed");
   EXPECT_EQ(used["rotation_bounds"], nlohmann::json({0.25, 0.5, 1.25}));
 
   const BoIcpConfig read_back = ConfigFromJson(used, "test");
@@ -103,6 +105,9 @@ TEST(SettingSchema, ConfigAsUsedNamesEveryRegistrationSettingAndReadsBack) {
   EXPECT_EQ(AllFields(SettingsFromConfig(read_back)), AllFields(SettingsFromConfig(config)));
 
   nlohmann::json bad = used;
+  bad["budget"] = "nope";
+  EXPECT_THROW(ConfigFromJson(bad, "test"), InputError);
+  bad = used;
   bad["voxel"] = "fine";
   EXPECT_THROW(ConfigFromJson(bad, "test"), InputError);
   bad["voxel"] = -1.0;
@@ -172,11 +177,44 @@ TEST(SettingSchema, OldRunJsonStillReads) {
   EXPECT_FALSE(s.translation_bounds);
   EXPECT_EQ(s.seed, 5u);
   EXPECT_TRUE(s.no_retry);
+  EXPECT_EQ(s.budget, "auto");  // run.json from before the budget existed
   EXPECT_EQ(s.resolution, 0.1);
   EXPECT_FALSE(s.max_range);
   nlohmann::json bad = old;
   bad["seed"] = "five";
   EXPECT_THROW(SettingsFromJson(bad, kMap, "run.json", s), InputError);
+}
+
+TEST(SettingSchema, BudgetIsAutoUnlessFixedOnEveryFrontEnd) {
+  for (const Frontend frontend : {kRegister, kMap, kSubmit}) {
+    EXPECT_EQ(ConfigFromSettings(ParseFlags(frontend, {"test"})).budget, Budget::kAuto);
+    const RequestedSettings fixed = ParseFlags(frontend, {"test", "--budget", "fixed"});
+    EXPECT_EQ(ConfigFromSettings(fixed).budget, Budget::kFixed) << frontend;
+    RequestedSettings read_back;
+    SettingsFromJson(SettingsToJson(fixed, frontend), frontend, "run.json", read_back);
+    EXPECT_EQ(read_back.budget, "fixed") << frontend;
+  }
+  EXPECT_EQ(SettingsFromConfig(PresetConfig("A")).budget, "auto");
+}
+
+// An unknown word is one error naming the flag as typed and the words it takes.
+TEST(SettingSchema, AnUnknownWordNamesItsFlagAndTheWordsAllowed) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"--budget", "--budget: unknown budget 'nope' (expected auto or fixed)"},
+      {"--mode", "--mode: unknown search mode 'nope' (expected nested or 6dof)"},
+      {"--icp-objective",
+       "--icp-objective: unknown ICP objective 'nope' (expected point or plane)"},
+      {"--config", "--config: unknown preset 'nope' (expected A, B or C)"}};
+  for (const Frontend frontend : {kRegister, kMap, kSubmit}) {
+    for (const auto& [flag, message] : cases) {
+      try {
+        ParseFlags(frontend, {"test", flag, "nope"});
+        ADD_FAILURE() << flag << " nope accepted";
+      } catch (const InputError& e) {
+        EXPECT_STREQ(e.what(), message);
+      }
+    }
+  }
 }
 
 TEST(SettingSchema, MapSettingsKeepDefaultsAndValidate) {

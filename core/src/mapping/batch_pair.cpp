@@ -1,6 +1,8 @@
 #include "boicp/mapping/batch_pair.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <optional>
 
 namespace boicp {
 namespace {
@@ -29,8 +31,13 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
   callbacks.stop_requested = stop_requested;
   BatchPairResult out;
   out.seed = config.seed;
-  out.registration =
-      RegisterPair(source_points, target_points, config, PairPrior(source, target), callbacks);
+  // Scans next to each other in a batch are usually a drive's consecutive
+  // scans, which ICP from identity aligns: the ladder's prior rung tries it.
+  const std::optional<Transform> guess = std::abs(pair.source - pair.target) == 1
+                                             ? std::optional<Transform>(Transform::Identity())
+                                             : std::nullopt;
+  out.registration = RegisterPair(source_points, target_points, config, PairPrior(source, target),
+                                  callbacks, guess);
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <open3d/geometry/PointCloud.h>
 
 #include "boicp/registration/preprocess.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "util/percentile.hpp"
 
 namespace boicp {
@@ -218,14 +219,14 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFo
 }
 
 ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds, CloudFormat format,
-                                       uint64_t seed, size_t max_clouds) {
+                                       uint64_t seed, size_t max_clouds, int threads) {
   if (clouds.empty()) throw InputError("automatic settings need at least one cloud");
   const size_t count = std::min(std::max<size_t>(max_clouds, 1), clouds.size());
-  std::vector<CloudStatistics> stats;
-  for (size_t k = 0; k < count; ++k) {
+  std::vector<CloudStatistics> stats(count);
+  ParallelFor(count, threads, [&](size_t k) {
     const size_t index = count == 1 ? 0 : k * (clouds.size() - 1) / (count - 1);
-    stats.push_back(MeasureCloud(*clouds[index], seed + index));
-  }
+    stats[k] = MeasureCloud(*clouds[index], seed + index);
+  });
   return ChooseSettings(stats, format);
 }
 

@@ -83,6 +83,19 @@ class Evaluator {
     result_.history.reserve(static_cast<size_t>(total));
   }
 
+  // Takes over the evaluations of an earlier run of the same search, without
+  // reporting them again.
+  void Restore(const std::vector<BayesOptSample>& done) {
+    for (const BayesOptSample& sample : done) {
+      if (result_.history.empty() || sample.y < result_.best_y) {
+        result_.best_y = sample.y;
+        result_.best_x = sample.x;
+        result_.best_index = result_.history.size();
+      }
+      result_.history.push_back(sample);
+    }
+  }
+
   // Every point of a round is told the same incumbent, so the values do not
   // depend on how many of them run at once.
   void EvaluateRound(const std::vector<Eigen::VectorXd>& xs) {
@@ -185,8 +198,7 @@ std::vector<Eigen::VectorXd> ProposeRound(GaussianProcess gp,
 BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points,
-                                const BayesOptProgress& progress,
-                                const std::function<bool()>& stop_requested) {
+                                const BayesOptHooks& hooks) {
   ValidateOptions(options, periodic);
   const auto d = static_cast<int>(periodic.size());
   std::mt19937_64 rng(seed);
@@ -196,8 +208,10 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
   const auto q = static_cast<size_t>(options.batch_size);
 
   BayesOptResult result;
-  Evaluator evaluator(f, total, options.threads, progress, stop_requested, result);
-  for (size_t first = 0; first < design.size(); first += q) {
+  Evaluator evaluator(f, total, options.threads, hooks.progress, hooks.stop_requested, result);
+  evaluator.Restore(hooks.resume);
+  const auto enough = [&] { return hooks.enough && hooks.enough(result.history); };
+  for (size_t first = result.history.size(); first < design.size(); first += q) {
     evaluator.EvaluateRound(
         {design.begin() + static_cast<std::ptrdiff_t>(first),
          design.begin() + static_cast<std::ptrdiff_t>(std::min(first + q, design.size()))});
@@ -207,7 +221,9 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
   GpHyperparameters fitted;
   bool have_fit = false;
   int since_fit = 0;
-  for (int done = 0; done < options.iterations;) {
+  const int resumed_iterations =
+      std::max(0, static_cast<int>(result.history.size()) - static_cast<int>(design.size()));
+  for (int done = resumed_iterations; done < options.iterations && !enough();) {
     const int round = std::min(options.batch_size, options.iterations - done);
     const bool refit = !have_fit || since_fit >= options.refit_every;
     UpdateSurrogate(gp, result.history, options.fit,
@@ -231,6 +247,15 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
                                                           options.confidence_candidates, rng);
   result.hyperparameters = gp.hyperparameters();
   return result;
+}
+
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+                                const BayesOptOptions& options, uint64_t seed,
+                                const std::vector<Eigen::VectorXd>& initial_points,
+                                const BayesOptProgress& progress,
+                                const std::function<bool()>& stop_requested) {
+  return MinimiseBayesOpt(f, periodic, options, seed, initial_points,
+                          BayesOptHooks{progress, stop_requested, {}, {}});
 }
 
 BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,

@@ -28,6 +28,14 @@ std::string IcpObjectiveName(IcpObjective objective) {
   return objective == IcpObjective::kPointToPoint ? "point" : "plane";
 }
 
+Budget ParseBudget(const std::string& name) {
+  if (name == "auto") return Budget::kAuto;
+  if (name == "fixed") return Budget::kFixed;
+  throw InputError("unknown budget '" + name + "' (expected auto or fixed)");
+}
+
+std::string BudgetName(Budget budget) { return budget == Budget::kAuto ? "auto" : "fixed"; }
+
 const std::vector<std::string> kAutoRegistrationFields = {
     "voxel", "refine_voxel", "objective_truncation", "translation_bounds", "rotation_bounds"};
 

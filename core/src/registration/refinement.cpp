@@ -59,7 +59,8 @@ IcpOptions SearchIcpOptions(const BoIcpConfig& config) {
   return options;
 }
 
-PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config) {
+PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config,
+                         std::optional<uint64_t> level_seed) {
   std::vector<double> voxels = {config.voxel};
   for (double voxel : RefinementVoxels(config.voxel, config.EffectiveRefineVoxel())) {
     voxels.push_back(voxel);
@@ -80,7 +81,8 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
       sources[level] = PrepareCloud(source, config, voxels[level], "source");
     } else {
       sources[level] = RandomSubsample(PrepareCloud(source, config, voxels[level], "source"),
-                                       config.refine_source_points, config.seed ^ kLevelSalt);
+                                       config.refine_source_points,
+                                       level_seed.value_or(config.seed) ^ kLevelSalt);
     }
   });
   PreparedPair pair{std::move(sources[0]), std::move(*targets[0]), {}, {}};
@@ -103,6 +105,7 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   };
   std::vector<Candidate> alive;
   for (const Transform& start : starts) alive.push_back({start, 0.0});
+  std::vector<Transform> abandoned;  // where the runs that headed for a worse fit stopped
 
   IcpOptions options = SearchIcpOptions(config);
   options.max_iterations = config.refine_max_iterations;
@@ -124,7 +127,10 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
       options.abandon_above =
           k == 0 ? std::numeric_limits<double>::infinity() : kClearlyWorse * survivors[0].score;
       const IcpResult icp = AlignPointToPoint(source, target, alive[k].T, options);
-      if (icp.abandoned) continue;
+      if (icp.abandoned) {
+        abandoned.push_back(icp.transform);
+        continue;
+      }
       const bool met = std::any_of(survivors.begin(), survivors.end(), [&](const Candidate& c) {
         const Transform delta = c.T.inverse() * icp.transform;
         return TranslationNorm(delta) < voxel && RotationAngle(delta) < M_PI / 180.0;
@@ -156,8 +162,25 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
                    [&](size_t a, size_t b) { return scores[a].fitness > scores[b].fitness; });
   RefinedAlignment refined{alive[order[0]].T, scores[order[0]], 1.0,
                            AngularResolutionDeg(finest.source, finest.voxel)};
-  if (order.size() > 1 && refined.score.fitness > 0.0) {
-    refined.margin = 1.0 - scores[order[1]].fitness / refined.score.fitness;
+  // The runner-up is the next basin at the finest level, or else the best
+  // fit of a run abandoned on the way (scored where it stopped, which is
+  // below what it would have reached). Only when every start met the
+  // answer's basin is there none, and that agreement counts as a full margin.
+  std::optional<double> runner_up;
+  if (order.size() > 1) {
+    runner_up = scores[order[1]].fitness;
+  } else {
+    for (const Transform& T : abandoned) {
+      runner_up = std::max(runner_up.value_or(0.0),
+                           ScoreAlignment(finest.source, finest.target, T,
+                                          config.EffectiveInlierDistance(), config.threads)
+                               .fitness);
+    }
+  }
+  if (refined.score.fitness <= 0.0 || starts.size() == 1) {
+    refined.margin = 0.0;  // nothing fits, or nothing was compared
+  } else if (runner_up) {
+    refined.margin = std::max(0.0, 1.0 - *runner_up / refined.score.fitness);
   }
   return refined;
 }

@@ -1,5 +1,6 @@
 #include "boicp/registration/search_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "boicp/registration/config.hpp"
@@ -24,6 +25,22 @@ Transform SearchSpace::ToTransform(const Eigen::VectorXd& u) const {
   offset.topLeftCorner<3, 3>() = R;
   offset.topRightCorner<3, 1>() = pivot + value.tail<3>() - R * pivot;
   return offset * anchor;
+}
+
+Eigen::VectorXd SearchSpace::ToUnit(const Transform& T) const {
+  const Transform offset = T * anchor.inverse();
+  const Eigen::Matrix3d R = offset.topLeftCorner<3, 3>();
+  Eigen::Matrix<double, 6, 1> value;
+  value[kRoll] = std::atan2(R(2, 1), R(2, 2));
+  value[kPitch] = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  value[kYaw] = std::atan2(R(1, 0), R(0, 0));
+  value.tail<3>() = offset.topRightCorner<3, 1>() - pivot + R * pivot;
+  Eigen::VectorXd u(dimension());
+  for (int k = 0; k < dimension(); ++k) {
+    const int p = parameters[k];
+    u[k] = std::clamp(0.5 + value[p] / (2.0 * half_widths[p]), 0.0, 1.0);
+  }
+  return u;
 }
 
 std::vector<bool> SearchSpace::Periodic() const {

@@ -23,7 +23,8 @@ struct BatchPairResult {
 
 /// Loads scans[pair.source] and scans[pair.target] and runs BO-ICP with
 /// `job_config` but seed PairSeed(job_config.seed, pair), centred on
-/// PairPrior when both scans have a prior pose. Throws Cancelled when
+/// PairPrior when both scans have a prior pose; scans adjacent in the batch
+/// get identity as the ladder's guess (RegisterPair). Throws Cancelled when
 /// `stop_requested` fires, InputError when a scan does not load (or an
 /// index is out of range), std::runtime_error for engine failures.
 BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,

@@ -53,9 +53,11 @@ struct ChosenSettings {
 ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format);
 
 /// Measures up to `max_clouds` of `clouds`, evenly spread (a batch's settings
-/// come from a few scans, so that every pair of it shares them), and chooses.
+/// come from a few scans, so that every pair of it shares them), and chooses;
+/// the clouds are measured on up to `threads` threads at once, which does not
+/// change the choice.
 ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds, CloudFormat format,
-                                       uint64_t seed, size_t max_clouds = 5);
+                                       uint64_t seed, size_t max_clouds = 5, int threads = 1);
 
 /// Copies the chosen values into the fields of `config` still listed in
 /// config.automatic (the voxel scaled as the preset's is against C's) and

@@ -60,6 +60,23 @@ using BoundedObjective = std::function<double(const Eigen::VectorXd& unit_x, dou
 /// Called after each evaluation with the number done and the total planned.
 using BayesOptProgress = std::function<void(int done, int total, double best_y)>;
 
+/// Decides after a round whether a search has learned enough to end early:
+/// told the history so far (every evaluation, in order). Only asked once the
+/// initial design has been evaluated.
+using BayesOptEnough = std::function<bool(const std::vector<BayesOptSample>& history)>;
+
+/// What a caller may add to a search beyond its options.
+struct BayesOptHooks {
+  BayesOptProgress progress;
+  std::function<bool()> stop_requested;
+  BayesOptEnough enough;  // empty: the whole budget
+  /// The history of an earlier run of this same search (objective, box,
+  /// options, initial points and seed) that `enough` ended: those
+  /// evaluations count as done and are not repeated, and the search goes on
+  /// to the full budget from there.
+  std::vector<BayesOptSample> resume;
+};
+
 /// Minimises f over [0,1]^d with d = periodic.size(). Evaluations run in
 /// rounds of options.batch_size points (the initial design too). `initial_points` (rows in
 /// the box, for example a prior guess) replace the first Latin-hypercube
@@ -82,6 +99,13 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
                                 const std::vector<Eigen::VectorXd>& initial_points = {},
                                 const BayesOptProgress& progress = {},
                                 const std::function<bool()>& stop_requested = {});
+
+/// The same with every hook: an early end (hooks.enough) and the
+/// continuation of a search that ended early (hooks.resume).
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+                                const BayesOptOptions& options, uint64_t seed,
+                                const std::vector<Eigen::VectorXd>& initial_points,
+                                const BayesOptHooks& hooks);
 
 /// The same for an objective that always returns f(x).
 BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,

@@ -25,27 +25,48 @@ struct Evaluation {
   double objective = 0.0;                     // truncated mean distance after ICP, metres
 };
 
+/// The rungs of the escalation ladder (Budget::kAuto), cheapest first. Each
+/// runs only while the answers before it are doubtful; a fixed budget runs
+/// the full search and the retry only.
+enum class Rung {
+  kPrior,        ///< the refinement from the pair's prior (or a drive's identity guess)
+  kFeatures,     ///< FPFH correspondence hypotheses, refined
+  kShortSearch,  ///< the search, each stage ending once its best basin is confirmed
+  kFullSearch,   ///< the same search continued to the preset's full budget
+  kRetry,        ///< a 6-DOF search with another seed, seeded with what came before
+};
+
+/// "prior", "features", "short-search", "full-search" or "retry".
+std::string RungName(Rung rung);
+
 /// What one attempt of a registration did.
 enum class AttemptKind {
-  kSearch,           ///< a BO search and the refinement of its best distinct ends
+  kPrior,        ///< the prior rung's refinement
+  kFeatures,     ///< the feature rung's hypotheses, refined
+  kShortSearch,  ///< a search whose stages stop once their best basin is confirmed
+  kSearch,  ///< a BO search (or the rest of a short one) and the refinement of its best distinct
+            ///< ends
   kWiderRefinement,  ///< more distinct ends of the first search refined and compared
 };
 
-/// "search" or "wider-refinement".
+/// "prior", "features", "short-search", "search" or "wider-refinement".
 std::string AttemptKindName(AttemptKind kind);
 
-/// One attempt of a registration: the first search, and for a doubtful answer
-/// a wider refinement of that search and then a second search.
+/// One attempt of a registration: a rung of the ladder, or for a fixed
+/// budget the search, and for a doubtful answer a wider refinement of that
+/// search and then a second search.
 struct Attempt {
   AttemptKind kind = AttemptKind::kSearch;
   SearchMode mode = SearchMode::kNested;
   uint64_t seed = 0;
   double fitness = 0.0;  // inlier fraction of its refined answer at the finest level
   double confidence = 0.0;
-  int evaluations = 0;   // ICP runs of its search (0 for a wider refinement)
-  int refined_ends = 0;  // distinct search ends compared at the finest level, at most
+  int evaluations = 0;   // ICP runs it made (search evaluations, or refined starts)
+  int refined_ends = 0;  // distinct starts compared at the finest level, at most
   double runtime_s = 0.0;
-  bool kept = false;  // its answer is the result's
+  bool kept = false;                            // its answer is the result's
+  Transform transform = Transform::Identity();  // its answer, T_target_source
+  ConfidenceFeatures features;                  // what its confidence came from
 };
 
 /// A result whose confidence is below this is reported as doubtful.
@@ -55,7 +76,9 @@ constexpr double kDoubtfulBelow = 0.5;
 /// T_target_source, so p_target = transform * p_source (metres, radians).
 struct RegistrationResult {
   Transform transform = Transform::Identity();
-  double objective = 0.0;    // best search objective (truncated mean NN distance, metres)
+  /// Best search objective (truncated mean NN distance, metres); for an
+  /// answer of the prior or feature rung, that objective at the answer.
+  double objective = 0.0;
   double fitness = 0.0;      // fraction of refined source points within inlier_distance
   double inlier_rmse = 0.0;  // RMS distance of those points, metres
   /// How firmly those inliers pin down `transform` (PairInformation over the
@@ -78,9 +101,10 @@ struct RegistrationResult {
   double gp_mean = 0.0;             // GP posterior mean at the optimum (last stage), metres
   double gp_std = 0.0;              // GP posterior standard deviation there, metres
   double probability_better = 0.0;  // max over stages of the GP's P(some other point is better)
-  int evaluations = 0;              // ICP runs made by the kept search
-  double runtime_s = 0.0;           // wall time of RegisterPair, retries included
-  size_t source_points = 0;         // after search downsampling
+  int evaluations = 0;              // ICP runs of every attempt together
+  Rung answered_by = Rung::kFullSearch;  // the rung whose answer was kept
+  double runtime_s = 0.0;                // wall time of RegisterPair, retries included
+  size_t source_points = 0;              // after search downsampling
   size_t target_points = 0;
   std::vector<Evaluation> history;  // of the kept search
   std::vector<Attempt> attempts;    // every search made, first first
@@ -112,13 +136,18 @@ struct RegistrationCallbacks {
 /// Registers `source` onto `target` (raw clouds in their sensor frames).
 /// Fields still in config.automatic are first chosen from the two clouds
 /// (auto_settings.hpp). `prior`, when given (for example odometry), centres
-/// the search box and is the first sample. A doubtful answer is searched for
-/// once more when config.retry_when_doubtful. Throws InputError for an
+/// the search box and is the first sample. With Budget::kAuto the rungs of
+/// the ladder (Rung) run in turn until one answer is trusted: the prior rung
+/// starts from `prior`, or without one from `guess` (for example identity for
+/// consecutive scans of a drive; unlike a prior it does not move the search
+/// box). A doubtful answer is searched for once more when
+/// config.retry_when_doubtful. Throws InputError for an
 /// invalid config, a cloud too small to choose settings from or left empty by
 /// cropping/downsampling, and Cancelled when stop_requested fires.
 RegistrationResult RegisterPair(const Points& source, const Points& target,
                                 const BoIcpConfig& config,
                                 const std::optional<Transform>& prior = std::nullopt,
-                                const RegistrationCallbacks& callbacks = {});
+                                const RegistrationCallbacks& callbacks = {},
+                                const std::optional<Transform>& guess = std::nullopt);
 
 }  // namespace boicp

@@ -28,6 +28,19 @@ enum class IcpObjective {
 IcpObjective ParseIcpObjective(const std::string& name);  // "point" | "plane"; throws InputError
 std::string IcpObjectiveName(IcpObjective objective);
 
+/// How much a registration may spend on a pair.
+enum class Budget {
+  /// An escalation ladder (bo_icp.hpp): cheap rungs first, each later rung
+  /// only while the answer is doubtful.
+  kAuto,
+  /// The paper's search: the preset's full budget, then the retry of a
+  /// doubtful answer; no prior or feature rung, no stopping rule.
+  kFixed,
+};
+
+Budget ParseBudget(const std::string& name);  // "auto" | "fixed"; throws InputError
+std::string BudgetName(Budget budget);
+
 /// The library's BO settings with 1000 EI candidates per proposal (see
 /// BoIcpConfig::bo).
 BayesOptOptions RegistrationBayesOptOptions();
@@ -51,6 +64,8 @@ struct BoIcpConfig {
   std::vector<std::string> automatic = kAutoRegistrationFields;
   /// Removes `field` from `automatic`: the user set it.
   void MarkSet(const std::string& field);
+
+  Budget budget = Budget::kAuto;
 
   // --- Search (the paper's N_r, N and voxel) -------------------------------
   int random_samples = 30;  // N_r: space-filling samples per search stage

@@ -5,6 +5,7 @@
 // every baseline the bench compares it with, so that methods differ only in
 // how they find the initial transform.
 
+#include <optional>
 #include <vector>
 
 #include "boicp/registration/alignment_score.hpp"
@@ -47,7 +48,11 @@ struct PreparedPair {
 };
 
 /// Throws InputError when a cloud is left with fewer than 3 points at any level.
-PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config);
+/// The finer levels' sources are subsampled with `level_seed` (default
+/// config.seed), so two searches with different seeds can share their finest
+/// points and compare their answers on them.
+PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config,
+                         std::optional<uint64_t> level_seed = std::nullopt);
 
 /// A refined transform (T_target_source) and how well it fits at the finest
 /// level, scored with the config's inlier distance.
@@ -55,7 +60,10 @@ struct RefinedAlignment {
   Transform transform = Transform::Identity();
   AlignmentScore score;
   /// 1 - (runner-up's fitness / the answer's fitness) at the finest level, in
-  /// [0, 1]: 0 when another basin fits as well, 1 when none reached that level.
+  /// [0, 1]: 0 when another basin fits as well, when the answer has no
+  /// inliers, or when there was a single start (nothing to compare with).
+  /// The runner-up of a lone survivor is the best run abandoned on the way,
+  /// scored where it stopped; 1 when every start met the answer's basin.
   double margin = 1.0;
   /// The angle that moves a finest-level source point at the cloud's RMS
   /// radius by one refinement voxel, degrees: how finely that level can

@@ -29,6 +29,11 @@ struct SearchSpace {
 
   int dimension() const { return static_cast<int>(parameters.size()); }
   Transform ToTransform(const Eigen::VectorXd& u) const;
+  /// The unit coordinates whose transform comes closest to T: T's offset from
+  /// the anchor as Euler angles (pitch in [-pi/2, pi/2]) and a translation of
+  /// the pivot, each clamped into the box. Parameters the box does not search
+  /// are dropped, so ToTransform(ToUnit(T)) == T only for T inside the box.
+  Eigen::VectorXd ToUnit(const Transform& T) const;
 
   /// Roll and yaw wrap around when their half-width reaches pi.
   std::vector<bool> Periodic() const;

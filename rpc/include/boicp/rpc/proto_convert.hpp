@@ -42,6 +42,10 @@ v1::ScanMetadata ScanMetadataOf(const ScanSource& scan);
 /// optional sha256 (64 lowercase hex digits). Throws InputError naming the field.
 void ValidateScanMetadata(const v1::ScanMetadata& metadata);
 
+/// The rung whose answer a pair kept (RungName's word). Results stored
+/// before it was recorded carry none: every answer then was a full search.
+std::string AnsweredBy(const v1::PairResult& pair);
+
 /// True for SUCCEEDED, FAILED and CANCELLED.
 bool IsTerminal(v1::JobState state);
 /// "queued", "running", "succeeded", "failed", "cancelled" ("unspecified" otherwise).

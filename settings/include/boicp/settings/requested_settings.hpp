@@ -22,6 +22,7 @@ struct RequestedSettings {
   std::string preset = "C";             // the paper's A, B or C (case-insensitive)
   std::string mode = "nested";          // nested | 6dof
   std::string icp_objective = "plane";  // plane | point: the search evaluations' ICP
+  std::string budget = "auto";          // auto (the escalation ladder) | fixed (the full search)
   uint64_t seed = 1;                    // job seed; each pair's seed derives from it
   bool fixed_settings = false;          // the preset's fixed voxel, bounds and map settings
   bool no_retry = false;                // never search a doubtful pair again

@@ -21,7 +21,8 @@ using FlagTexts = std::map<std::string, std::string>;
 void AddSettingFlags(CLI::App& app, Frontend frontend, RequestedSettings& settings,
                      FlagTexts& texts);
 
-/// Parses `texts` into `settings`. Throws InputError naming the flag.
+/// Parses `texts` into `settings` and checks the word settings (--config,
+/// --mode, --budget, ...). Throws InputError naming the flag.
 void ApplyFlagTexts(const FlagTexts& texts, Frontend frontend, RequestedSettings& settings);
 
 }  // namespace boicp::settings
