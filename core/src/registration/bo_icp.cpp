@@ -582,30 +582,35 @@ std::vector<Transform> ProbesAround(const Transform& guess, const Point& source_
   return probes;
 }
 
-// Feature hypotheses of the search clouds: FPFH (normals within 3 search
-// voxels, features within 5) matched and solved by RANSAC over the
-// correspondences, a few distinct ones, most inliers first.
+// Feature hypotheses of the search clouds: FPFH (normals within 3 voxels,
+// features within 5) matched and solved by RANSAC over the correspondences,
+// a few distinct ones, most inliers first. The clouds are first thinned to
+// about kFeaturePoints points (a surface's points fall with the square of
+// the voxel): matching costs the product of the two clouds' sizes, and
+// hypotheses need only land in ICP's basin.
+constexpr size_t kFeaturePoints = 4000;
+
 std::vector<Transform> FeatureGuesses(const PreparedPair& prepared, const BoIcpConfig& config) {
-  const double voxel = config.voxel;
-  const NearestNeighborIndex source(prepared.search_source);
+  const size_t points = std::max(prepared.search_source.size(), prepared.search_target.size());
+  const double voxel =
+      config.voxel *
+      std::sqrt(std::max(1.0, static_cast<double>(points) / static_cast<double>(kFeaturePoints)));
+  const NearestNeighborIndex source(VoxelDownsample(prepared.search_source, voxel));
+  const NearestNeighborIndex target(VoxelDownsample(prepared.search_target.points(), voxel));
   const Points source_normals = EstimateSurfaceNormals(source, 3.0 * voxel, config.threads);
-  const Points target_normals =
-      prepared.search_target_normals.empty()
-          ? EstimateSurfaceNormals(prepared.search_target, 3.0 * voxel, config.threads)
-          : prepared.search_target_normals;
+  const Points target_normals = EstimateSurfaceNormals(target, 3.0 * voxel, config.threads);
   const FpfhFeatures source_features =
       ComputeFpfhFeatures(source, source_normals, 5.0 * voxel, config.threads);
   const FpfhFeatures target_features =
-      ComputeFpfhFeatures(prepared.search_target, target_normals, 5.0 * voxel, config.threads);
+      ComputeFpfhFeatures(target, target_normals, 5.0 * voxel, config.threads);
   FeatureMatchOptions options;
   options.inlier_distance = 1.5 * voxel;
   options.distinct_translation = 3.0 * voxel;
   options.seed = config.seed ^ kFeatureSalt;
   options.threads = config.threads;
   std::vector<Transform> guesses;
-  for (const FeatureHypothesis& h :
-       FeatureHypotheses(prepared.search_source, source_features, prepared.search_target.points(),
-                         target_features, options)) {
+  for (const FeatureHypothesis& h : FeatureHypotheses(source.points(), source_features,
+                                                      target.points(), target_features, options)) {
     guesses.push_back(h.transform);
   }
   return guesses;

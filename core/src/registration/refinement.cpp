@@ -123,10 +123,15 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
     options.convergence_translation = 1e-3 * voxel;
     options.truncation = 1.5 * voxel;
     std::vector<Candidate> survivors;
+    std::vector<Transform> ends;  // the survivors' ends, which a run that reaches stops at
+    // Half of "met" below: a run that close to a survivor's end is in its basin.
+    options.join_translation = 0.5 * voxel;
+    options.join_rotation = 0.5 * M_PI / 180.0;
     for (size_t k = 0; k < alive.size(); ++k) {
       options.abandon_above =
           k == 0 ? std::numeric_limits<double>::infinity() : kClearlyWorse * survivors[0].score;
-      const IcpResult icp = AlignPointToPoint(source, target, alive[k].T, options);
+      const IcpResult icp = AlignPointToPoint(source, target, alive[k].T, options, ends);
+      if (icp.joined_end >= 0) continue;
       if (icp.abandoned) {
         abandoned.push_back(icp.transform);
         continue;
@@ -139,6 +144,7 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
       survivors.push_back({icp.transform, ScoreAlignment(source, target, icp.transform,
                                                          options.truncation, options.threads)
                                               .truncated_mean});
+      ends.push_back(icp.transform);
     }
     // Leader of the next level first; the sort is stable so ties keep the search's order.
     std::stable_sort(survivors.begin(), survivors.end(),
