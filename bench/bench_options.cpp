@@ -109,6 +109,18 @@ BenchOptions ParseBenchOptions(int argc, const char* const* argv) {
         }
       },
       "yaw|axis90|any|none: source perturbation (default: per dataset)");
+  app.add_option_function<std::string>(
+      "--field",
+      [&](const std::string& v) {
+        try {
+          o.field = ParseFieldCondition(v);
+        } catch (const std::exception& e) {
+          throw UsageError(std::string("--field: ") + e.what());
+        }
+      },
+      FieldConditionNames() +
+          ": what is done to every loaded pair (default clean; "
+          "bench/field_conditions.hpp)");
   app.add_option("--max-angle-deg", o.max_angle_deg, "Largest axis perturbation angle (default 90)")
       ->check(CLI::PositiveNumber);
   app.add_option("--seed", options.seed, "Base seed of every random choice")->capture_default_str();

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "boicp/registration/evaluation.hpp"
+#include "field_conditions.hpp"
 
 namespace boicp::bench {
 
@@ -34,6 +35,7 @@ struct DatasetOverrides {
   bool automatic_settings = false;      // BO methods choose voxel and boxes from the clouds
   bool retry_when_doubtful = true;      // BO methods search again when doubtful
   std::string icp_objective = "plane";  // BO methods' search evaluations: plane | point
+  FieldCondition field = FieldCondition::kClean;  // applied to every loaded pair
 };
 
 struct BenchOptions {

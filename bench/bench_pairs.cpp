@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 #include "boicp/io/point_cloud_io.hpp"
 #include "seeds.hpp"
@@ -12,6 +13,8 @@ namespace {
 std::string RelativeName(const std::string& path, const std::string& folder) {
   return std::filesystem::path(path).lexically_relative(folder).generic_string();
 }
+
+constexpr uint64_t kFieldSalt = 0x8ebc6af09c88c6e3ULL;
 
 uint64_t PairSeed(const DatasetPairs& dataset, size_t index, uint64_t seed) {
   return MixSeed(MixSeed(seed, NameSeed(dataset.settings.name)), index);
@@ -72,8 +75,14 @@ BenchPair LoadPair(const DatasetPairs& dataset, size_t index, uint64_t seed) {
     load.depth.depth_scale = dataset.settings.depth_scale;
   }
   const ReferencePair& reference = dataset.references.at(index);
-  return PerturbPair(dataset, index, seed, LoadPointCloud(reference.source, load).points,
-                     LoadPointCloud(reference.target, load).points);
+  FieldPair field = ApplyFieldCondition(
+      dataset.settings.field, LoadPointCloud(reference.source, load).points,
+      LoadPointCloud(reference.target, load).points, PairSeed(dataset, index, seed) ^ kFieldSalt);
+  BenchPair pair =
+      PerturbPair(dataset, index, seed, std::move(field.source), std::move(field.target));
+  pair.expected = field.target_motion * reference.T_target_source * field.source_motion.inverse() *
+                  pair.perturbation.inverse();
+  return pair;
 }
 
 }  // namespace boicp::bench

@@ -70,6 +70,7 @@ DatasetSettings SettingsForDataset(const std::string& folder_name,
   s.automatic_settings = overrides.automatic_settings;
   s.retry_when_doubtful = overrides.retry_when_doubtful;
   s.icp_objective = overrides.icp_objective;
+  s.field = overrides.field;
   return s;
 }
 
@@ -91,6 +92,8 @@ std::string DescribeSettings(const DatasetSettings& s) {
     text += "; BO methods: automatic settings (voxel and bounds above unused)";
   if (!s.retry_when_doubtful) text += "; BO methods: no retries";
   if (s.icp_objective == "point") text += "; BO methods: point-to-point ICP in the search";
+  if (s.field != FieldCondition::kClean)
+    text += "; field condition: " + FieldConditionName(s.field);
   if (s.depth_scale > 0.0) {
     text += ", depth PNG scale " + std::to_string(static_cast<int>(s.depth_scale)) + "/m with " +
             s.intrinsics_file;

@@ -26,7 +26,8 @@ struct DatasetSettings {
   std::string intrinsics_file;      // depth PNGs: camera file, relative to the folder
   bool automatic_settings = false;  // BO methods ignore voxel and bounds and choose their own
   bool retry_when_doubtful = true;
-  std::string icp_objective = "plane";  // BO methods' search evaluations
+  std::string icp_objective = "plane";            // BO methods' search evaluations
+  FieldCondition field = FieldCondition::kClean;  // what is done to the loaded scans
 };
 
 /// The table entry for `folder_name` (matched by prefix: "kitti", "7scenes",

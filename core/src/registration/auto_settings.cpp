@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
-#include <open3d/geometry/KDTreeFlann.h>
-#include <open3d/geometry/PointCloud.h>
-
+#include "boicp/registration/nearest_neighbors.hpp"
 #include "boicp/registration/preprocess.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "util/percentile.hpp"
@@ -119,13 +118,13 @@ double Median(std::vector<double> values) { return Percentile(std::move(values),
 // Median distance from a point to its nearest other point, over
 // kSpacingQueries random points (seeded) against the whole cloud.
 double PointSpacing(const Points& cloud, uint64_t seed) {
-  const open3d::geometry::PointCloud o3d(cloud);
-  const open3d::geometry::KDTreeFlann tree(o3d);
+  const NearestNeighborIndex tree(cloud);
   std::vector<double> gaps;
-  std::vector<int> indices;
+  std::vector<size_t> indices;
   std::vector<double> squared;
   for (const Point& p : RandomSubsample(cloud, kSpacingQueries, seed)) {
-    if (tree.SearchKNN(p, 2, indices, squared) == 2) gaps.push_back(std::sqrt(squared[1]));
+    tree.KNearest(p, 2, std::numeric_limits<double>::infinity(), indices, squared);
+    if (indices.size() == 2) gaps.push_back(std::sqrt(squared[1]));
   }
   return gaps.empty() ? 0.0 : Median(gaps);
 }

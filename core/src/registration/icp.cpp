@@ -5,8 +5,10 @@
 #include <limits>
 #include <string>
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include "boicp/registration/preprocess.hpp"
 #include "boicp/util/parallel_for.hpp"
 
 namespace boicp {
@@ -69,6 +71,44 @@ int JoinedEnd(const Transform& T, const std::vector<Transform>& known_ends,
   return joined;
 }
 
+// A rigid step as one 6-vector: rotation vector times `radius` (metres,
+// about how far it moves the cloud's points) and translation.
+using Twist = Eigen::Matrix<double, 6, 1>;
+
+Twist TwistOf(const Transform& step, double radius) {
+  const Eigen::AngleAxisd rotation(Eigen::Matrix3d(step.topLeftCorner<3, 3>()));
+  Twist twist;
+  twist.head<3>() = rotation.axis() * rotation.angle() * radius;
+  twist.tail<3>() = step.topRightCorner<3, 1>();
+  return twist;
+}
+
+// The step taken `factor` times over: its rotation angle and its
+// translation scaled alike.
+Transform ScaledStep(const Transform& step, double factor) {
+  const Eigen::AngleAxisd rotation(Eigen::Matrix3d(step.topLeftCorner<3, 3>()));
+  Transform scaled = Transform::Identity();
+  scaled.topLeftCorner<3, 3>() =
+      Eigen::AngleAxisd(rotation.angle() * factor, rotation.axis()).toRotationMatrix();
+  scaled.topRightCorner<3, 1>() = factor * step.topRightCorner<3, 1>();
+  return scaled;
+}
+
+// Steps closer than this in direction (cosine) continue one motion.
+constexpr double kSameDirection = 0.95;
+
+// How far past `step` a run that took `previous` and then `step` should jump,
+// in steps: the rest of the geometric series the two start, or 0 when they
+// do not start one.
+double ExtrapolationFactor(const Twist& previous, const Twist& step) {
+  const double previous_norm = previous.norm(), norm = step.norm();
+  if (!(previous_norm > 0.0 && norm > 0.0)) return 0.0;
+  if (previous.dot(step) < kSameDirection * previous_norm * norm) return 0.0;
+  const double ratio = norm / previous_norm;
+  if (ratio >= 1.0) return 0.0;
+  return std::min(ratio / (1.0 - ratio), kMaxExtrapolation);
+}
+
 }  // namespace
 
 double ProjectedLimit(double f0, double f1, double f2, int remaining_steps) {
@@ -109,6 +149,16 @@ IcpResult RunIcp(const Points& source, const NearestNeighborIndex& target, const
   }
   // Truncated means of the last three iterations, oldest first.
   double history[3] = {0.0, 0.0, 0.0};
+  // Extrapolation: the last step's twist, and the pose a jump left from
+  // with the fit measured before it.
+  const double radius = options.extrapolate ? std::max(RmsRadius(source), 1e-9) : 0.0;
+  const double fit_truncation =
+      options.truncation > 0.0 ? options.truncation : options.max_correspondence_distance;
+  bool may_jump = options.extrapolate;
+  Twist previous_step = Twist::Zero();  // zero: none to extrapolate from
+  bool jumped = false;
+  Transform jumped_from = Transform::Identity();
+  double fit = 0.0, fit_before_jump = 0.0;
 
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     result.joined_end = JoinedEnd(result.transform, known_ends, options);
@@ -137,6 +187,16 @@ IcpResult RunIcp(const Points& source, const NearestNeighborIndex& target, const
       return result;
     }
     result.rmse = std::sqrt(sum_sq / static_cast<double>(count));
+    if (options.extrapolate) {
+      fit = TruncatedMean(match, sq_distance, fit_truncation);
+      if (jumped && fit > fit_before_jump) {
+        result.transform = jumped_from;  // match again where the jump started
+        jumped = false;
+        may_jump = false;
+        continue;
+      }
+      jumped = false;
+    }
     if (may_abandon) {
       history[0] = history[1];
       history[1] = history[2];
@@ -154,6 +214,19 @@ IcpResult RunIcp(const Points& source, const NearestNeighborIndex& target, const
         RotationAngle(step) < options.convergence_rotation) {
       result.converged = true;
       break;
+    }
+    if (may_jump) {
+      const Twist twist = TwistOf(step, radius);
+      const double factor = ExtrapolationFactor(previous_step, twist);
+      if (factor > 0.0) {
+        jumped = true;
+        jumped_from = result.transform;
+        fit_before_jump = fit;
+        result.transform = ScaledStep(step, factor) * result.transform;
+        previous_step = Twist::Zero();
+      } else {
+        previous_step = twist;
+      }
     }
   }
   return result;

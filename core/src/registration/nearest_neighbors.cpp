@@ -167,11 +167,19 @@ bool NearestNeighborIndex::NearestWithHint(const Point& query, size_t hint,
 
 void NearestNeighborIndex::KNearest(const Point& query, size_t k, double max_squared_distance,
                                     std::vector<size_t>& indices) const {
+  std::vector<double> squared_distances;
+  KNearest(query, k, max_squared_distance, indices, squared_distances);
+}
+
+void NearestNeighborIndex::KNearest(const Point& query, size_t k, double max_squared_distance,
+                                    std::vector<size_t>& indices,
+                                    std::vector<double>& squared_distances) const {
   indices.resize(k);
-  std::vector<double> squared_distances(k);
+  squared_distances.resize(k);
   size_t found = tree_->kdtree.knnSearch(query.data(), k, indices.data(), squared_distances.data());
   while (found > 0 && squared_distances[found - 1] > max_squared_distance) --found;
   indices.resize(found);
+  squared_distances.resize(found);
 }
 
 const Points& NearestNeighborIndex::points() const { return tree_->adaptor.points; }

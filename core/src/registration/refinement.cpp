@@ -116,6 +116,9 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   // One run at a time (each may stop on its leader's score), so the threads
   // go to its nearest-neighbour searches, which do not change the result.
   options.threads = config.threads;
+  // The ladder's refinement jumps along the steps it creeps by; the fixed
+  // budget refines exactly as the paper-era engine did.
+  options.extrapolate = config.budget == Budget::kAuto;
   // The search level first, then the pyramid, finest last.
   const auto run_level = [&](const Points& source, const NearestNeighborIndex& target, double voxel,
                              double gate) {

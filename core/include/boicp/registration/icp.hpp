@@ -32,7 +32,21 @@ struct IcpOptions {
   // there: translation (metres) and angle (radians) of T_end^-1 * T. 0 = never.
   double join_translation = 0.0;
   double join_rotation = 0.0;
+
+  // Where a surface lets ICP slide (a street, a long wall), point-to-point
+  // steps creep along it, each a little shorter than the last. With
+  // `extrapolate`, two steps in nearly the same direction, the second the
+  // shorter, are followed by a jump over what the geometric series of such
+  // steps would still cover (Besl and McKay's accelerated ICP), at most
+  // kMaxExtrapolation steps long. A jump that leaves the truncated mean
+  // distance (clipped at `truncation`, or at the gate when that is 0) above
+  // its value before the jump is undone, and the run jumps no more. The
+  // answer moves only within the convergence tolerances; the iterations fall.
+  bool extrapolate = false;
 };
+
+/// Longest jump of an extrapolating ICP run, in steps.
+constexpr double kMaxExtrapolation = 8.0;
 
 /// Outcome of one ICP run. `transform` is T_target_source: p_target = T * p_source.
 struct IcpResult {

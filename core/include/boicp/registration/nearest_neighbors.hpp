@@ -45,6 +45,9 @@ class NearestNeighborIndex {
   /// is resized to their number. Thread-safe for concurrent queries.
   void KNearest(const Point& query, size_t k, double max_squared_distance,
                 std::vector<size_t>& indices) const;
+  /// The same, with their squared distances (metres^2) in `squared_distances`.
+  void KNearest(const Point& query, size_t k, double max_squared_distance,
+                std::vector<size_t>& indices, std::vector<double>& squared_distances) const;
 
   const Points& points() const;
   size_t size() const { return points().size(); }

@@ -12,7 +12,8 @@ namespace boicp {
 Points CropByRange(const Points& points, double min_range, double max_range);
 
 /// Replaces the points in each cubic voxel of edge `voxel` metres by their
-/// centroid (Open3D's VoxelDownSample). voxel <= 0 returns the input unchanged.
+/// centroid: the points of Open3D's VoxelDownSample, in its order. voxel <= 0
+/// returns the input unchanged.
 Points VoxelDownsample(const Points& points, double voxel);
 
 /// At most `max_points` points chosen uniformly without replacement, in their

@@ -82,6 +82,7 @@ struct RefinedAlignment {
 /// that reach the finest level, the one with the largest inlier fraction
 /// wins: the coarse scores of a low-overlap pair's true basin and of a wrong
 /// one can differ by less than their noise, while the fine fit tells them apart.
+/// Under Budget::kAuto the runs extrapolate (IcpOptions::extrapolate).
 constexpr double kClearlyWorse = 1.3;
 
 RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const PreparedPair& pair,
