@@ -103,11 +103,19 @@ int RunRegister(const RegisterFlags& flags) {
                    source.points.size(), target.points.size(), source.dropped_nonfinite,
                    target.dropped_nonfinite);
       std::fprintf(stderr, "%s\n", DescribeSettings(config, auto_fields, chosen.sensor).c_str());
+      if (chosen.far_returns[0] + chosen.far_returns[1] > 0) {
+        std::fprintf(stderr,
+                     "%zu source and %zu target points set aside as far returns when choosing "
+                     "the settings (they stay in the scans)\n",
+                     chosen.far_returns[0], chosen.far_returns[1]);
+      }
     }
     const RegistrationResult result =
         RegisterPair(source.points, target.points, config, prior, MakeProgressPrinter(flags.quiet));
     if (flags.json) {
-      std::cout << RegistrationToJson(result, auto_fields).dump() << std::endl;
+      nlohmann::json out = RegistrationToJson(result, auto_fields);
+      out["far_returns"] = {{"source", chosen.far_returns[0]}, {"target", chosen.far_returns[1]}};
+      std::cout << out.dump() << std::endl;
     } else {
       PrintHuman(result);
     }

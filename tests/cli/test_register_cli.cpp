@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -86,6 +87,7 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   for (const nlohmann::json& name : j["auto"]) {
     EXPECT_TRUE(j["config"].contains(name.get<std::string>())) << name << " names no setting";
   }
+  EXPECT_EQ(j["far_returns"], nlohmann::json({{"source", 0}, {"target", 0}}));
   EXPECT_FALSE(j["doubtful"].get<bool>());
   // The answer lies inside its search box.
   EXPECT_GE(j["search_reach"].get<double>(), 0.0);
@@ -100,6 +102,41 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_THAT(text.out, HasSubstr("answered_by " + j["answered_by"].get<std::string>() + "\n"));
   EXPECT_THAT(text.out, HasSubstr("evaluations " + std::to_string(j["evaluations"].get<int>())));
+}
+
+// Returns 1-2 km out (rain, a reflection), 1 in 50 of the source's points:
+// set aside when choosing the settings, counted, and the pair still
+// registers near the truth.
+TEST_F(Cli, FarReturnsAreCountedAndDoNotMoveTheSettings) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const std::string common = "register --target " + (dir_ / "target.xyz").string() +
+                             " --config A --seed 3 --rotation-bounds 0.2,0.2,pi --json";
+  const RunResult clean = Run(common + " --source " + (dir_ / "source.xyz").string());
+  ASSERT_EQ(clean.exit_code, 0) << clean.err;
+
+  std::ifstream in(dir_ / "source.xyz");
+  std::ofstream out(dir_ / "source_far.xyz");
+  std::string line;
+  int lines = 0, added = 0;
+  while (std::getline(in, line)) {
+    out << line << "\n";
+    if (++lines % 50 == 0) {
+      const double angle = 0.1 * lines, range = 1000.0 + lines % 1000;
+      out << range * std::cos(angle) << " " << range * std::sin(angle) << " 5\n";
+      ++added;
+    }
+  }
+  out.close();
+  const RunResult far = Run(common + " --source " + (dir_ / "source_far.xyz").string());
+  ASSERT_EQ(far.exit_code, 0) << far.err;
+  EXPECT_THAT(far.err, HasSubstr(std::to_string(added) + " source and 0 target points set aside"));
+  const nlohmann::json a = nlohmann::json::parse(clean.out), b = nlohmann::json::parse(far.out);
+  EXPECT_EQ(b["far_returns"], nlohmann::json({{"source", added}, {"target", 0}}));
+  const double voxel = a["config"]["voxel"].get<double>();
+  EXPECT_NEAR(b["config"]["voxel"].get<double>(), voxel, 0.03 * voxel);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(b["transform"][i][3].get<double>(), a["transform"][i][3].get<double>(), 0.1);
+  }
 }
 
 // The paper's search, as before the ladder: nested, (10 + 20) evaluations a

@@ -75,6 +75,29 @@ TEST(AutoSettings, LengthsFollowTheScenesScale) {
   EXPECT_EQ(big.rotation_bounds, small.rotation_bounds);
 }
 
+// 3 % of the camera's returns through a window, 60-150 m out in one
+// direction: they drag a centroid and an RMS radius, not the settings.
+TEST(AutoSettings, FarReturnsThroughAWindowAreSetAside) {
+  const Points view = CameraView();
+  Points with_window = view;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> across(-0.3, 0.3), range(60.0, 150.0);
+  const size_t added = 3 * view.size() / 100;
+  for (size_t i = 0; i < added; ++i) {
+    with_window.push_back(range(rng) * Point(across(rng), across(rng), 1.0).normalized());
+  }
+  const CloudStatistics clean = MeasureCloud(view, 1);
+  const CloudStatistics window = MeasureCloud(with_window, 1);
+  EXPECT_EQ(clean.far_returns, 0u);
+  EXPECT_EQ(window.far_returns, added);
+  const ChosenSettings a = ChooseSettings({clean}, CloudFormat::kAuto);
+  const ChosenSettings b = ChooseSettings({window}, CloudFormat::kAuto);
+  EXPECT_NEAR(b.voxel, a.voxel, 0.03 * a.voxel);
+  EXPECT_TRUE(b.translation_bounds.isApprox(a.translation_bounds, 0.03));
+  EXPECT_NEAR(b.map_max_range, a.map_max_range, 0.03 * a.map_max_range);
+  EXPECT_THAT(b.far_returns, ElementsAre(added));
+}
+
 TEST(AutoSettings, TooSmallOrFlatCloudIsOneClearError) {
   const Points few(50, Point(1, 2, 3));
   try {
@@ -86,6 +109,12 @@ TEST(AutoSettings, TooSmallOrFlatCloudIsOneClearError) {
   }
   const Points one_place(500, Point(1, 2, 3));
   EXPECT_THROW(MeasureCloud(one_place, 1), InputError);
+  // Most points in one place leave no median distance to call others far by.
+  Points mostly_one_place = one_place;
+  for (int i = 0; i < 200; ++i) mostly_one_place.push_back(Point(i, 0.5 * i, 1.0));
+  const CloudStatistics stats = MeasureCloud(mostly_one_place, 1);
+  EXPECT_EQ(stats.far_returns, 0u);
+  EXPECT_GT(stats.rms_radius, 10.0);
 }
 
 TEST(AutoSettings, OnlyFieldsLeftAutomaticAreChosen) {

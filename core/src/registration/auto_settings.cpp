@@ -54,6 +54,13 @@ constexpr int kPlaneTrials = 200;
 // those of the whole cloud by far less than the rules' precision.
 constexpr size_t kMeasuredPoints = 20000;
 constexpr size_t kSpacingQueries = 1000;
+// Far returns (through a window or an open door, off rain or dust) lie many
+// times farther from the scene's middle than its typical point, and a few
+// percent of them would set the RMS radius, and with it every rule above.
+// Points beyond 12 median distances from the coordinate-wise median point are
+// set aside before measuring: clean scans reach 8 (a KITTI street's far
+// end), 4 (a 7-Scenes room) and 3 (the bunny).
+constexpr double kFarReturnMedians = 12.0;
 
 bool SeesAllAround(const Points& points) {
   // A cone of view (a camera's, or an object seen from one side) has its
@@ -115,6 +122,30 @@ std::optional<double> GroundTilt(const Points& points, double tolerance, uint64_
 
 double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
 
+// Where far returns begin: a sphere about the coordinate-wise median point,
+// which a few percent of far points cannot drag as they drag a centroid.
+struct FarReturnGate {
+  Point centre;
+  double max_distance;
+  bool Excludes(const Point& p) const { return (p - centre).norm() > max_distance; }
+};
+
+FarReturnGate FarReturnGateOf(const Points& points) {
+  std::vector<double> x, y, z;
+  for (const Point& p : points) {
+    x.push_back(p.x());
+    y.push_back(p.y());
+    z.push_back(p.z());
+  }
+  const Point centre(Median(std::move(x)), Median(std::move(y)), Median(std::move(z)));
+  std::vector<double> distances;
+  for (const Point& p : points) distances.push_back((p - centre).norm());
+  // Half the points in one place give no scale to measure "far" by.
+  const double median = Median(std::move(distances));
+  return {centre,
+          median > 0.0 ? kFarReturnMedians * median : std::numeric_limits<double>::infinity()};
+}
+
 // Median distance from a point to its nearest other point, over
 // kSpacingQueries random points (seeded) against the whole cloud.
 double PointSpacing(const Points& cloud, uint64_t seed) {
@@ -156,9 +187,17 @@ CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
   if (cloud.size() < kMinPointsForSettings) {
     throw InputError("a cloud has " + std::to_string(cloud.size()) + " points, too few" + advice);
   }
-  const Points points = RandomSubsample(cloud, kMeasuredPoints, seed);
+  const Points sample = RandomSubsample(cloud, kMeasuredPoints, seed);
+  const FarReturnGate gate = FarReturnGateOf(sample);
+  Points points;
+  points.reserve(sample.size());
+  for (const Point& p : sample) {
+    if (!gate.Excludes(p)) points.push_back(p);
+  }
   CloudStatistics stats;
   stats.points = cloud.size();
+  stats.far_returns = static_cast<size_t>(
+      std::count_if(cloud.begin(), cloud.end(), [&](const Point& p) { return gate.Excludes(p); }));
   std::vector<double> ranges;
   ranges.reserve(points.size());
   for (const Point& p : points) ranges.push_back(p.norm());
@@ -187,6 +226,7 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFo
     if (s.ground_tilt) tilts.push_back(*s.ground_tilt);
   }
   ChosenSettings chosen;
+  for (const CloudStatistics& s : stats) chosen.far_returns.push_back(s.far_returns);
   if (format == CloudFormat::kKittiBin || (format != CloudFormat::kDepthPng && all_around)) {
     chosen.sensor = SensorKind::kLidar;
   } else if (format == CloudFormat::kDepthPng) {

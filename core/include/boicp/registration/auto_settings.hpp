@@ -21,6 +21,9 @@ std::string SensorKindName(SensorKind kind);  // "lidar" | "depth camera" | "oth
 /// What the settings are chosen from, measured on one cloud in its sensor frame.
 struct CloudStatistics {
   size_t points = 0;
+  /// Points set aside as far returns (beyond 12 median distances from the
+  /// median point) before every statistic below; 0 on a clean scan.
+  size_t far_returns = 0;
   double rms_radius = 0.0;  // RMS distance from the centroid, metres
   double range_p95 = 0.0;   // 95th percentile of the distance from the sensor origin, metres
   double spacing = 0.0;     // median distance from a point to its nearest other point, metres
@@ -46,6 +49,7 @@ struct ChosenSettings {
   Eigen::Vector3d rotation_bounds = Eigen::Vector3d::Zero();     // radians
   double map_resolution = 0.0;                                   // metres
   double map_max_range = 0.0;                                    // metres
+  std::vector<size_t> far_returns;  // set aside in each measured cloud, in order
 };
 
 /// The settings for clouds measured by `stats` (at least one), read in
