@@ -46,13 +46,12 @@ std::ifstream OpenOrThrow(const std::string& path, std::ios::openmode mode) {
 }
 
 std::vector<std::string_view> SplitFields(std::string_view line) {
-  constexpr std::string_view kSeparators = " \t,\r";
   std::vector<std::string_view> fields;
-  size_t pos = line.find_first_not_of(kSeparators);
+  size_t pos = line.find_first_not_of(kFieldSeparators);
   while (pos != std::string_view::npos) {
-    const size_t end = line.find_first_of(kSeparators, pos);
+    const size_t end = line.find_first_of(kFieldSeparators, pos);
     fields.push_back(line.substr(pos, end == std::string_view::npos ? end : end - pos));
-    pos = end == std::string_view::npos ? end : line.find_first_not_of(kSeparators, end);
+    pos = end == std::string_view::npos ? end : line.find_first_not_of(kFieldSeparators, end);
   }
   return fields;
 }

@@ -21,8 +21,11 @@ void RequireReadableFile(const std::string& path);
 /// Opens `path` or throws InputError naming it and the OS reason.
 std::ifstream OpenOrThrow(const std::string& path, std::ios::openmode mode = std::ios::in);
 
-/// Splits a text line into fields separated by runs of spaces, tabs, commas
-/// or carriage returns (files written on Windows keep their '\r').
+/// What separates the fields of a text line: runs of spaces, tabs, commas or
+/// carriage returns (files written on Windows keep their '\r').
+inline constexpr std::string_view kFieldSeparators = " \t,\r";
+
+/// Splits a text line into its fields (kFieldSeparators).
 std::vector<std::string_view> SplitFields(std::string_view line);
 
 /// Parses a whole token as a double, independent of the C locale. Accepts a

@@ -1,7 +1,9 @@
 // Plain-text files: XYZ point lists and rigid transforms.
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <string_view>
 
 #include "io/io_readers.hpp"
 
@@ -21,17 +23,24 @@ std::string Quoted(const std::string& line) {
   return "'" + line.substr(0, kQuotedLineLimit) + "...'";
 }
 
-// Reads x y z from the first three fields; later columns (intensity, colour,
-// labels) may hold anything and are ignored.
-Point ParseXyzLine(const std::string& line, const std::string& location) {
-  const std::vector<std::string_view> fields = SplitFields(line);
+// Reads x y z from the first three fields (kFieldSeparators); later columns
+// (intensity, colour, labels) may hold anything and are ignored. Allocates
+// nothing unless the line is bad: a scan has hundreds of thousands of lines.
+Point ParseXyzLine(std::string_view line, const std::string& path, size_t line_number) {
   Point point;
-  for (size_t i = 0; i < 3; ++i) {
-    const std::optional<double> value = i < fields.size() ? ParseNumber(fields[i]) : std::nullopt;
-    if (!value) {
-      throw InputError(location + ": expected at least 3 numbers (x y z), got " + Quoted(line));
+  size_t pos = line.find_first_not_of(kFieldSeparators);
+  for (Eigen::Index i = 0; i < 3; ++i) {
+    std::optional<double> value;
+    if (pos != std::string_view::npos) {
+      const size_t end = std::min(line.find_first_of(kFieldSeparators, pos), line.size());
+      value = ParseNumber(line.substr(pos, end - pos));
+      pos = line.find_first_not_of(kFieldSeparators, end);
     }
-    point[static_cast<Eigen::Index>(i)] = *value;
+    if (!value) {
+      throw InputError(path + ":" + std::to_string(line_number) +
+                       ": expected at least 3 numbers (x y z), got " + Quoted(std::string(line)));
+    }
+    point[i] = *value;
   }
   return point;
 }
@@ -104,7 +113,7 @@ Points ReadXyzText(const std::string& path, uint64_t max_points) {
   for (size_t line_number = 1; std::getline(in, line); ++line_number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (IsBlankOrComment(line)) continue;
-    points.push_back(ParseXyzLine(line, path + ":" + std::to_string(line_number)));
+    points.push_back(ParseXyzLine(line, path, line_number));
   }
   if (in.bad()) throw InputError(path + ": read error");
   return points;
