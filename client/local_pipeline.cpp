@@ -145,8 +145,10 @@ LocalRun PrepareRun(const MapSettings& settings) {
 }
 
 void ChooseRunSettings(LocalRun& run) {
-  run.auto_fields =
+  BatchSettingsChoice choice =
       ApplyBatchSettings(run.folder.scans, run.config, run.map.occupancy, run.map_auto);
+  run.auto_fields = std::move(choice.fields);
+  run.measured = std::move(choice.measured);
   run.map_auto = {false, false};
   ValidateConfig(run.config);
   ValidateOccupancySettings(run.map.occupancy);
@@ -162,6 +164,17 @@ void PrintRunSettings(const LocalRun& run) {
       run.config.rotation_bounds[0], run.config.rotation_bounds[1], run.config.rotation_bounds[2],
       run.map.occupancy.resolution, run.map.occupancy.max_range,
       run.auto_fields.empty() ? "" : "; from the scans: ", JoinNames(run.auto_fields).c_str());
+  size_t far_returns = 0, scans_with_far_returns = 0;
+  for (const MeasuredScan& m : run.measured) {
+    far_returns += m.far_returns;
+    scans_with_far_returns += m.far_returns > 0;
+  }
+  if (far_returns > 0) {
+    std::fprintf(stderr,
+                 "settings: %zu points of %zu of the %zu measured scans set aside as far returns "
+                 "(they stay in the scans; run.json lists them)\n",
+                 far_returns, scans_with_far_returns, run.measured.size());
+  }
 }
 
 json RunManifestJson(const LocalRun& run) {
@@ -170,6 +183,11 @@ json RunManifestJson(const LocalRun& run) {
   manifest["chosen"]["map_resolution"] = run.map.occupancy.resolution;
   manifest["chosen"]["map_max_range"] = run.map.occupancy.max_range;
   manifest["auto"] = run.auto_fields;
+  manifest["far_returns"] = json::array();
+  for (const MeasuredScan& m : run.measured) {
+    manifest["far_returns"].push_back(
+        {{"scan", run.folder.scans[m.scan].path}, {"points", m.far_returns}});
+  }
   return manifest;
 }
 

@@ -46,6 +46,7 @@ struct LocalRun {
   MapBuildSettings map;
   MapAutoFields map_auto;                // map settings still to be chosen from the scans
   std::vector<std::string> auto_fields;  // the settings ChooseRunSettings chose
+  std::vector<MeasuredScan> measured;    // the scans it chose them from
   bool keyframes = false;                // overlap pairing
   double overlap_threshold = 0;          // keyframes only
   std::vector<PairIndex> plan;           // consecutive or explicit pairs; empty for keyframes
@@ -62,8 +63,9 @@ void ChooseRunSettings(LocalRun& run);
 /// One "settings: ..." line on stderr: the values used and which were chosen.
 void PrintRunSettings(const LocalRun& run);
 
-/// run.json: the settings as given, plus "chosen" (the settings used) and
-/// "auto" (which of them came from the scans).
+/// run.json: the settings as given, plus "chosen" (the settings used),
+/// "auto" (which of them came from the scans) and "far_returns" (the points
+/// of each measured scan set aside while choosing them).
 nlohmann::json RunManifestJson(const LocalRun& run);
 
 /// "source,target" index pairs, one a line ('#' comments, blank lines and a

@@ -16,6 +16,7 @@ nlohmann::json ChosenSettingsToJson(const v1::ChosenSettings& s) {
   out["map_resolution"] = s.map_resolution();
   out["map_max_range"] = s.map_max_range();
   out["auto"] = s.auto_fields();
+  out["far_returns"] = s.far_returns();
   return out;
 }
 
@@ -27,16 +28,21 @@ std::string DescribeChosenSettings(const v1::ChosenSettings& s) {
   }
   // Jobs stored before the budget existed carry none.
   const std::string budget = c.budget().empty() ? "" : ", budget " + c.budget();
+  const std::string far_returns =
+      s.far_returns() == 0
+          ? ""
+          : "; " + std::to_string(s.far_returns()) + " far returns set aside while choosing";
   char text[512];
   std::snprintf(text, sizeof text,
                 "preset %s, %s%s, voxel %.3g m, refine voxel %.3g m, translation bounds "
                 "%.3g,%.3g,%.3g m, rotation bounds %.3g,%.3g,%.3g rad, map resolution %.3g m, "
-                "ray length %.3g m%s%s",
+                "ray length %.3g m%s%s%s",
                 c.preset().c_str(), c.mode().c_str(), budget.c_str(), c.voxel(), c.refine_voxel(),
                 c.translation_bounds().x(), c.translation_bounds().y(), c.translation_bounds().z(),
                 c.rotation_bounds().x(), c.rotation_bounds().y(), c.rotation_bounds().z(),
                 s.map_resolution(), s.map_max_range(),
-                automatic.empty() ? "" : "; from the scans: ", automatic.c_str());
+                automatic.empty() ? "" : "; from the scans: ", automatic.c_str(),
+                far_returns.c_str());
   return text;
 }
 

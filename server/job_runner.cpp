@@ -95,10 +95,9 @@ class JobRun : public MapProgressSink {
                                ctx_.registration_threads);
     VerifyScans();
     // Chosen once from the job's scans; a resumed job chooses the same again.
-    const std::vector<std::string> auto_fields = ApplyBatchSettings(
+    const BatchSettingsChoice choice = ApplyBatchSettings(
         batch_spec_.scans, batch_spec_.config, batch_spec_.map.occupancy, batch_spec_.map_auto);
-    *job_.mutable_settings() =
-        ChosenSettingsToProto(batch_spec_.config, batch_spec_.map, auto_fields);
+    *job_.mutable_settings() = ChosenSettingsToProto(batch_spec_.config, batch_spec_.map, choice);
     job_.mutable_settings()->set_scan_format(
         rpc::ScanFormatOf(batch_spec_.scans.at(0).load.format));
     batch_.scans = batch_spec_.scans;

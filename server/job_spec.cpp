@@ -110,12 +110,15 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
 }
 
 v1::ChosenSettings ChosenSettingsToProto(const BoIcpConfig& config, const MapBuildSettings& map,
-                                         const std::vector<std::string>& auto_fields) {
+                                         const BatchSettingsChoice& choice) {
   v1::ChosenSettings out;
   *out.mutable_config() = rpc::RegistrationConfigToProto(settings::SettingsFromConfig(config));
   out.set_map_resolution(map.occupancy.resolution);
   out.set_map_max_range(map.occupancy.max_range);
-  for (const std::string& field : auto_fields) out.add_auto_fields(field);
+  for (const std::string& field : choice.fields) out.add_auto_fields(field);
+  uint64_t far_returns = 0;
+  for (const MeasuredScan& m : choice.measured) far_returns += m.far_returns;
+  out.set_far_returns(far_returns);
   return out;
 }
 

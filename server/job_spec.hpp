@@ -41,9 +41,10 @@ BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads);
 MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto);
 
 /// The settings a job runs with, for its record: `config` and `map` as
-/// resolved, and the names of the fields chosen from the scans.
+/// resolved, the names of the fields chosen from the scans and the far
+/// returns set aside while choosing them.
 v1::ChosenSettings ChosenSettingsToProto(const BoIcpConfig& config, const MapBuildSettings& map,
-                                         const std::vector<std::string>& auto_fields);
+                                         const BatchSettingsChoice& choice);
 
 /// Validates everything about a batch except that its scans exist (the
 /// caller looked them up to get `scans`). Throws InputError naming the field.

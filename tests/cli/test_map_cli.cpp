@@ -339,6 +339,37 @@ TEST_F(MapCli, GeneratedDriveWritesEveryOutputAndRerunsReusePairs) {
   EXPECT_GT(DistinctColours(dir_ / "p.png"), 10u);
 }
 
+// Returns 1-2 km out in one scan: set aside while choosing the settings,
+// listed per measured scan in run.json, and the drive still maps.
+TEST_F(MapCli, FarReturnsAreListedInRunJson) {
+  const fs::path scans = MakeDrive(3);
+  Points scan = LoadPointCloud((scans / "scan001.xyz").string()).points;
+  const size_t added = scan.size() / 50;
+  for (size_t i = 0; i < added; ++i) {
+    const double angle = 0.1 * static_cast<double>(i), range = 1000.0 + static_cast<double>(i);
+    scan.push_back(Point(range * std::cos(angle), range * std::sin(angle), 5.0));
+  }
+  WriteXyz((scans / "scan001.xyz").string(), scan);
+  const fs::path out = dir_ / "out";
+  const RunResult r = Run("map " + scans.string() + " -o " + out.string() + Quick());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr(std::to_string(added) + " points of 1 of the 3 measured scans"));
+  const json manifest = json::parse(Slurp(out / "run.json"));
+  ASSERT_EQ(manifest["far_returns"].size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    const json& entry = manifest["far_returns"][i];
+    EXPECT_EQ(fs::path(entry["scan"].get<std::string>()).filename(),
+              "scan00" + std::to_string(i) + ".xyz");
+    EXPECT_EQ(entry["points"], i == 1 ? added : 0u) << "scan " << i;
+  }
+  const std::vector<Transform> poses = ReadKittiTrajectory((out / "trajectory.kitti").string());
+  ASSERT_EQ(poses.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    const Transform expected = truth_[0].inverse() * truth_[i];
+    EXPECT_NEAR(TranslationNorm(expected.inverse() * poses[i]), 0.0, 0.1) << "scan " << i;
+  }
+}
+
 TEST_F(MapCli, BadInputGivesOneLineErrorExitCode2AndNoMap) {
   const fs::path scans = MakeDrive(3);
   fs::create_directories(dir_ / "mixed");

@@ -41,13 +41,14 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
   return out;
 }
 
-std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans,
-                                            BoIcpConfig& config, OccupancySettings& occupancy,
-                                            const MapAutoFields& map_auto) {
+BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoIcpConfig& config,
+                                       OccupancySettings& occupancy,
+                                       const MapAutoFields& map_auto) {
   if (scans.empty()) throw InputError("a batch needs at least one scan");
   if (config.automatic.empty() && !map_auto.resolution && !map_auto.max_range) return {};
   constexpr size_t kSampledScans = 5;
   const size_t count = std::min(kSampledScans, scans.size());
+  BatchSettingsChoice choice;
   std::vector<Points> clouds;
   CloudFormat format = CloudFormat::kAuto;
   for (size_t k = 0; k < count; ++k) {
@@ -55,20 +56,23 @@ std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans
     LoadedCloud loaded = LoadPointCloud(scans[index].path, scans[index].load);
     format = loaded.format;
     clouds.push_back(std::move(loaded.points));
+    choice.measured.push_back({index, 0});
   }
   std::vector<const Points*> pointers;
   for (const Points& cloud : clouds) pointers.push_back(&cloud);
+  // Every loaded cloud is measured, in order (max_clouds = their number).
   const ChosenSettings chosen = ChooseSettingsForClouds(pointers, format, config.seed, count);
-  std::vector<std::string> set = ApplyChosenSettings(chosen, config);
+  for (size_t k = 0; k < count; ++k) choice.measured[k].far_returns = chosen.far_returns[k];
+  choice.fields = ApplyChosenSettings(chosen, config);
   if (map_auto.resolution) {
     occupancy.resolution = chosen.map_resolution;
-    set.push_back("map_resolution");
+    choice.fields.push_back("map_resolution");
   }
   if (map_auto.max_range) {
     occupancy.max_range = chosen.map_max_range;
-    set.push_back("map_max_range");
+    choice.fields.push_back("map_max_range");
   }
-  return set;
+  return choice;
 }
 
 double BatchOverlapThreshold(const std::vector<ScanSource>& scans) {

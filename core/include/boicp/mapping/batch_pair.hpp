@@ -37,15 +37,27 @@ struct MapAutoFields {
   bool max_range = true;   // OccupancySettings::max_range, reported as "map_max_range"
 };
 
+/// A scan the batch's settings were measured on, and the points of it set
+/// aside as far returns while measuring (CloudStatistics::far_returns).
+struct MeasuredScan {
+  size_t scan = 0;  // index into the batch's scans
+  size_t far_returns = 0;
+};
+
+/// What ApplyBatchSettings chose, and from which scans.
+struct BatchSettingsChoice {
+  std::vector<std::string> fields;  // names of the fields it set
+  std::vector<MeasuredScan> measured;
+};
+
 /// Chooses, once for the whole batch, the fields of `config` still in
 /// config.automatic and the map fields `map_auto` names, from up to 5 of the
 /// scans spread evenly over the batch (so every pair, every shard and every
-/// resume gets the same settings). Returns the names of the fields it set;
-/// loads nothing when nothing is automatic. Throws InputError when a scan
-/// does not load or is too small to choose settings from.
-std::vector<std::string> ApplyBatchSettings(const std::vector<ScanSource>& scans,
-                                            BoIcpConfig& config, OccupancySettings& occupancy,
-                                            const MapAutoFields& map_auto);
+/// resume gets the same settings). Loads nothing, and measures no scan, when
+/// nothing is automatic. Throws InputError when a scan does not load or is
+/// too small to choose settings from.
+BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoIcpConfig& config,
+                                       OccupancySettings& occupancy, const MapAutoFields& map_auto);
 
 /// The keyframe overlap threshold of a batch: that of its first non-depth
 /// scan's format (0.7), or 0.6 when every scan is a depth image.
