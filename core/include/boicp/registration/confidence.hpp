@@ -1,7 +1,8 @@
 #pragma once
 // How sure a registration is of its answer: a logistic model over what the
 // search and the refinement already measured, fitted on bench outcomes
-// (bench/fit_confidence.py; bench/README.md has its AUROC and reliability).
+// (bench/fit_confidence.py; bench/README.md has how it does on datasets it
+// was not fitted on).
 
 namespace boicp {
 

@@ -91,7 +91,7 @@ struct BoIcpConfig {
   double objective_truncation = 0.0;
   int icp_max_iterations = 60;  // per evaluation; fewer shrink the basin each start reaches
   // Source points (random, seeded) each evaluation uses; 0 = all. Fewer lose
-  // the true basin of low-overlap pairs (bench/README.md).
+  // the true basin of low-overlap pairs.
   size_t evaluation_points = 2000;
   // Each evaluation's ICP first runs on this many of those points (random,
   // seeded), where a step costs half, then finishes on all of them with the
