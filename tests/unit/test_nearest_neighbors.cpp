@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/nearest_neighbors.hpp"
@@ -111,6 +113,36 @@ TEST(NearestNeighbors, UnhintedQueriesMatchABruteForceScan) {
     Answer actual;
     actual.found = index.Nearest(query, 0.81, actual.index, actual.squared_distance);
     ExpectSame(street, BruteForce(street, query, 0.81), actual, "query " + std::to_string(q));
+  }
+}
+
+// Leaf size trades build time against search time only: the k nearest
+// points and their distances are the brute force's, for any leaf size.
+TEST(NearestNeighbors, EveryLeafSizeGivesTheBruteForceKNearest) {
+  const Points street = VoxelDownsample(MakeSyntheticStreet(3, 20.0), 0.3);
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<size_t> pick(0, street.size() - 1);
+  std::uniform_real_distribution<double> offset(-1.0, 1.0);
+  Points queries;
+  for (int q = 0; q < 500; ++q) {
+    queries.push_back(street[pick(rng)] + Point(offset(rng), offset(rng), offset(rng)));
+  }
+  for (size_t leaf : {size_t{1}, NearestNeighborIndex::kDefaultLeafSize,
+                      NearestNeighborIndex::kFewQueriesLeafSize, street.size() + 1}) {
+    const NearestNeighborIndex index(street, /*neighbour_lists=*/false, leaf);
+    std::vector<size_t> indices;
+    std::vector<double> squared;
+    for (const Point& query : queries) {
+      index.KNearest(query, 3, std::numeric_limits<double>::infinity(), indices, squared);
+      std::vector<double> expected;
+      for (const Point& p : street) expected.push_back((p - query).squaredNorm());
+      std::sort(expected.begin(), expected.end());
+      ASSERT_EQ(indices.size(), 3u) << "leaf " << leaf;
+      for (size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(squared[k], expected[k]) << "leaf " << leaf << ", neighbour " << k;
+        EXPECT_EQ((street[indices[k]] - query).squaredNorm(), squared[k]) << "leaf " << leaf;
+      }
+    }
   }
 }
 

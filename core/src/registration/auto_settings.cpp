@@ -149,7 +149,8 @@ FarReturnGate FarReturnGateOf(const Points& points) {
 // Median distance from a point to its nearest other point, over
 // kSpacingQueries random points (seeded) against the whole cloud.
 double PointSpacing(const Points& cloud, uint64_t seed) {
-  const NearestNeighborIndex tree(cloud);
+  const NearestNeighborIndex tree(cloud, /*neighbour_lists=*/false,
+                                  NearestNeighborIndex::kFewQueriesLeafSize);
   std::vector<double> gaps;
   std::vector<size_t> indices;
   std::vector<double> squared;

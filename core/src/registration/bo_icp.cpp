@@ -87,15 +87,15 @@ Registered RegisterFixed(const Points& source, const Points& target, const BoIcp
 
 // Starts around a guess that look for a competing basin next to it: the
 // guess turned both ways about the vertical through the pivot by a quarter
-// turn (or the yaw bound, when smaller), and moved both ways along the
-// translation axis with the widest bound by half that bound.
+// turn (or the yaw bound, when smaller), and moved both ways by half the
+// bound along every translation axis whose bound is at least half the
+// widest. A guess short of the motion along the direction of travel (which
+// a scan's axes do not tell) otherwise ends where ICP stalls on the way.
 std::vector<Transform> ProbesAround(const Transform& guess, const Point& source_centroid,
                                     const BoIcpConfig& config) {
   const Point pivot = guess.topLeftCorner<3, 3>() * source_centroid + guess.topRightCorner<3, 1>();
   const double turn = std::min(M_PI / 4, config.rotation_bounds[2]);
-  Eigen::Index axis = 0;
-  config.translation_bounds.maxCoeff(&axis);
-  const Eigen::Vector3d shift = Eigen::Vector3d::Unit(axis) * 0.5 * config.translation_bounds[axis];
+  const double widest = config.translation_bounds.maxCoeff();
   std::vector<Transform> probes;
   for (const double sign : {1.0, -1.0}) {
     if (turn > 0.0) {
@@ -105,9 +105,11 @@ std::vector<Transform> ProbesAround(const Transform& guess, const Point& source_
       turned.topRightCorner<3, 1>() = pivot - R * pivot;
       probes.push_back(turned * guess);
     }
-    if (shift.norm() > 0.0) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const double bound = config.translation_bounds[axis];
+      if (bound <= 0.0 || bound < 0.5 * widest) continue;
       Transform moved = guess;
-      moved.topRightCorner<3, 1>() += sign * shift;
+      moved(axis, 3) += sign * 0.5 * bound;
       probes.push_back(moved);
     }
   }

@@ -1,5 +1,6 @@
 #include "boicp/registration/nearest_neighbors.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -70,9 +71,9 @@ using KdTree =
 }  // namespace
 
 struct NearestNeighborIndex::Tree {
-  explicit Tree(Points pts)
+  Tree(Points pts, size_t leaf_size)
       : adaptor{std::move(pts)},
-        kdtree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {}
+        kdtree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(leaf_size)) {}
   PointsAdaptor adaptor;
   KdTree kdtree;
   // Point i's nearest other points are neighbours[i * kNeighbourListSize ...]
@@ -105,8 +106,8 @@ struct NearestNeighborIndex::Tree {
   }
 };
 
-NearestNeighborIndex::NearestNeighborIndex(Points points, bool neighbour_lists)
-    : tree_(std::make_unique<Tree>(std::move(points))) {
+NearestNeighborIndex::NearestNeighborIndex(Points points, bool neighbour_lists, size_t leaf_size)
+    : tree_(std::make_unique<Tree>(std::move(points), std::max<size_t>(leaf_size, 1))) {
   if (tree_->adaptor.points.empty())
     throw InputError("nearest-neighbour index: empty target cloud");
   // The lists hold 32-bit indices: a larger cloud is searched in the tree alone.

@@ -49,14 +49,22 @@ Points VoxelDownsample(const Points& points, double voxel) {
     int count = 0;
   };
   std::unordered_map<Eigen::Vector3i, Cell, open3d::utility::hash_eigen<Eigen::Vector3i>> cells;
+  // Scans list neighbouring points one after another, so a point often
+  // falls in the previous point's cell; that cell is reused without a lookup
+  // (map nodes do not move, and the map sees the same insertions).
+  Cell* previous = nullptr;
+  Eigen::Vector3i previous_key = Eigen::Vector3i::Zero();
   for (const Point& p : points) {
     const Point scaled = (p - origin) / voxel;
     const Eigen::Vector3i key(static_cast<int>(std::floor(scaled.x())),
                               static_cast<int>(std::floor(scaled.y())),
                               static_cast<int>(std::floor(scaled.z())));
-    Cell& cell = cells[key];
-    cell.sum += p;
-    ++cell.count;
+    if (previous == nullptr || key != previous_key) {
+      previous = &cells[key];
+      previous_key = key;
+    }
+    previous->sum += p;
+    ++previous->count;
   }
   Points centroids;
   centroids.reserve(cells.size());

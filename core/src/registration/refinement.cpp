@@ -1,6 +1,7 @@
 #include "boicp/registration/refinement.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -31,15 +32,20 @@ double AngularResolutionDeg(const Points& cloud, double voxel) {
   return rms_radius > 0.0 ? std::atan(voxel / rms_radius) * 180.0 / M_PI : 180.0;
 }
 
-}  // namespace
-
-Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
-  Points sampled = VoxelDownsample(CropByRange(raw, config.min_range, config.max_range), voxel);
+// One level of one cloud, from the cloud already cropped to the range limits.
+Points DownsampleCropped(const Points& cropped, double voxel, const char* which) {
+  Points sampled = VoxelDownsample(cropped, voxel);
   if (sampled.size() < 3) {
     throw InputError(std::string(which) + " cloud has " + std::to_string(sampled.size()) +
                      " points after cropping and downsampling (need at least 3)");
   }
   return sampled;
+}
+
+}  // namespace
+
+Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
+  return DownsampleCropped(CropByRange(raw, config.min_range, config.max_range), voxel, which);
 }
 
 IcpOptions SearchIcpOptions(const BoIcpConfig& config) {
@@ -68,6 +74,10 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
   // Every cloud of every level is independent of the others, so they are
   // built at once on the registration's threads; the search level's source
   // keeps every point, the finer ones at most refine_source_points.
+  std::array<Points, 2> cropped;  // source, target
+  ParallelFor(2, config.threads, [&](size_t which) {
+    cropped[which] = CropByRange(which == 0 ? source : target, config.min_range, config.max_range);
+  });
   std::vector<Points> sources(voxels.size());
   std::vector<std::optional<NearestNeighborIndex>> targets(voxels.size());
   ParallelFor(2 * voxels.size(), config.threads, [&](size_t task) {
@@ -75,12 +85,12 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
     if (task % 2 == 1) {
       // Every search evaluation queries the search level's target; the finer
       // ones serve a few refinement runs, too few to pay for neighbour lists.
-      targets[level].emplace(PrepareCloud(target, config, voxels[level], "target"),
+      targets[level].emplace(DownsampleCropped(cropped[1], voxels[level], "target"),
                              /*neighbour_lists=*/level == 0);
     } else if (level == 0) {
-      sources[level] = PrepareCloud(source, config, voxels[level], "source");
+      sources[level] = DownsampleCropped(cropped[0], voxels[level], "source");
     } else {
-      sources[level] = RandomSubsample(PrepareCloud(source, config, voxels[level], "source"),
+      sources[level] = RandomSubsample(DownsampleCropped(cropped[0], voxels[level], "source"),
                                        config.refine_source_points,
                                        level_seed.value_or(config.seed) ^ kLevelSalt);
     }
@@ -109,21 +119,24 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
 
   IcpOptions options = SearchIcpOptions(config);
   options.max_iterations = config.refine_max_iterations;
-  // The answer's accuracy is decided here: run each level until its steps
-  // are below 1/1000 voxel and 1e-4 rad (the search's 1/100 voxel and 1e-3
-  // rad cost the bunny 0.2-0.5 degrees and one flipped pair).
-  options.convergence_rotation = 1e-4;
   // One run at a time (each may stop on its leader's score), so the threads
   // go to its nearest-neighbour searches, which do not change the result.
   options.threads = config.threads;
-  // The ladder's refinement jumps along the steps it creeps by; the fixed
-  // budget refines exactly as the paper-era engine did.
-  options.extrapolate = config.budget == Budget::kAuto;
+  // The fixed budget refines exactly as the paper-era engine did: every
+  // level until its steps are below 1/1000 voxel and 1e-4 rad (the search's
+  // 1/100 voxel and 1e-3 rad cost the bunny 0.2-0.5 degrees and one flipped
+  // pair). The ladder jumps along the steps ICP creeps by, which lets it stop
+  // the finest level at 3/1000 voxel and 3e-4 rad, and the levels before it
+  // at the search's precision, since they only hand a start to the next.
+  const bool ladder = config.budget == Budget::kAuto;
+  options.extrapolate = ladder;
   // The search level first, then the pyramid, finest last.
   const auto run_level = [&](const Points& source, const NearestNeighborIndex& target, double voxel,
-                             double gate) {
+                             double gate, bool finest) {
     options.max_correspondence_distance = gate;
-    options.convergence_translation = 1e-3 * voxel;
+    const double precision = !ladder ? 1e-3 : finest ? 3e-3 : 1e-2;
+    options.convergence_translation = precision * voxel;
+    options.convergence_rotation = precision / 10.0;
     options.truncation = 1.5 * voxel;
     std::vector<Candidate> survivors;
     std::vector<Transform> ends;  // the survivors' ends, which a run that reaches stops at
@@ -154,9 +167,11 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
                      [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
     alive = std::move(survivors);
   };
-  run_level(pair.search_source, pair.search_target, config.voxel, 1.5 * config.voxel);
+  run_level(pair.search_source, pair.search_target, config.voxel, 1.5 * config.voxel,
+            /*finest=*/false);
   for (const PyramidLevel& level : pair.pyramid) {
-    run_level(level.source, level.target, level.voxel, 3.0 * level.voxel);
+    run_level(level.source, level.target, level.voxel, 3.0 * level.voxel,
+              /*finest=*/&level == &pair.pyramid.back());
   }
   const PyramidLevel& finest = pair.pyramid.back();
   std::vector<AlignmentScore> scores;

@@ -13,13 +13,23 @@ class NearestNeighborIndex {
  public:
   /// Length of a point's neighbour list (see the constructor).
   static constexpr size_t kNeighbourListSize = 16;
+  /// Leaf size for a tree that is queried about as often as it has points.
+  static constexpr size_t kDefaultLeafSize = 10;
+  /// Leaf size for a tree that is queried far less often than it has points
+  /// (a few thousand samples of a whole scan): it builds in a fraction of the
+  /// default's time, and those few searches cost little more.
+  static constexpr size_t kFewQueriesLeafSize = 64;
 
   /// Builds the tree over a copy of `points`. With `neighbour_lists`, also
   /// lists each point's kNeighbourListSize nearest other points, which let
   /// NearestWithHint answer most queries from the hint's list instead of the
   /// tree; building them costs one tree search a point, so they pay off on a
-  /// target that hundreds of ICP runs query. Precondition: points non-empty.
-  explicit NearestNeighborIndex(Points points, bool neighbour_lists = false);
+  /// target that hundreds of ICP runs query. `leaf_size` is the most points
+  /// a tree leaf holds: larger leaves build faster and search slower, and
+  /// every search gives the same answer whatever its value. Preconditions:
+  /// points non-empty, leaf_size >= 1.
+  explicit NearestNeighborIndex(Points points, bool neighbour_lists = false,
+                                size_t leaf_size = kDefaultLeafSize);
   ~NearestNeighborIndex();
   NearestNeighborIndex(NearestNeighborIndex&&) noexcept;
   NearestNeighborIndex& operator=(NearestNeighborIndex&&) noexcept;
