@@ -2,6 +2,8 @@
 // coarse-to-fine refinement every initialiser ends with.
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -49,6 +51,50 @@ TEST(Refinement, LevelSourcesKeepAtMostRefineSourcePointsAndTargetsKeepAll) {
     EXPECT_EQ(capped.pyramid[k].target.size(), all.pyramid[k].target.size());
   }
   EXPECT_EQ(capped.search_source.size(), all.search_source.size());
+}
+
+void ExpectSamePoints(const Points& expected, const Points& actual, const std::string& what) {
+  ASSERT_EQ(expected.size(), actual.size()) << what;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    ASSERT_EQ(expected[i], actual[i]) << what << ", point " << i;  // bit for bit, in order
+  }
+}
+
+void ExpectSamePreparedPair(const PreparedPair& expected, const PreparedPair& actual) {
+  ExpectSamePoints(expected.search_source, actual.search_source, "search source");
+  ExpectSamePoints(expected.search_target.points(), actual.search_target.points(), "search target");
+  ASSERT_EQ(expected.pyramid.size(), actual.pyramid.size());
+  for (size_t k = 0; k < expected.pyramid.size(); ++k) {
+    EXPECT_EQ(expected.pyramid[k].voxel, actual.pyramid[k].voxel);
+    ExpectSamePoints(expected.pyramid[k].source, actual.pyramid[k].source, "level source");
+    ExpectSamePoints(expected.pyramid[k].target.points(), actual.pyramid[k].target.points(),
+                     "level target");
+  }
+}
+
+// Pairs that share a scan share its pyramid: a pair prepared from pyramids
+// is the pair prepared from the raw scans, also for a config whose search
+// voxel the pyramids do not hold (a retry's), which is downsampled anew.
+TEST(Refinement, PairsPreparedFromScanPyramidsAreThePairsPreparedFromTheScans) {
+  const Points source = MakeSyntheticStreet(5, 20.0);
+  const Points target = TransformPoints(PoseFromYawTranslation(0.3, {1.0, 0.5, 0.0}), source);
+  BoIcpConfig config = StreetConfig();
+  config.max_range = 25.0;
+  config.refine_source_points = 2000;
+  const ScanPyramid source_pyramid = BuildScanPyramid(source, config);
+  const ScanPyramid target_pyramid = BuildScanPyramid(target, config);
+  EXPECT_EQ(source_pyramid.voxels, PyramidVoxels(config));
+  ExpectSamePreparedPair(PreparePair(source, target, config, 9),
+                         PreparePair(source_pyramid, target_pyramid, config, 9));
+
+  BoIcpConfig retry = config;
+  retry.voxel = 1.2;  // refinement levels 0.6, 0.3, 0.15, then the same 0.1
+  ExpectSamePreparedPair(PreparePair(source, target, retry, 9),
+                         PreparePair(source_pyramid, target_pyramid, retry, 9));
+
+  BoIcpConfig nearer = config;
+  nearer.max_range = 20.0;
+  EXPECT_THROW(PreparePair(source_pyramid, target_pyramid, nearer), std::invalid_argument);
 }
 
 // A street scan and the same scan moved by `truth`^-1, so T_target_source = truth.

@@ -2,28 +2,16 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <memory>
 #include <optional>
 
 namespace boicp {
-namespace {
-
-const ScanSource& ScanAt(const std::vector<ScanSource>& scans, int index) {
-  if (index < 0 || index >= static_cast<int>(scans.size())) {
-    throw InputError("pair index " + std::to_string(index) + " is outside the batch of " +
-                     std::to_string(scans.size()) + " scans");
-  }
-  return scans[static_cast<size_t>(index)];
-}
-
-}  // namespace
 
 BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                                  const BoIcpConfig& job_config,
+                                  const BoIcpConfig& job_config, ScanPyramidCache& pyramids,
                                   const std::function<bool()>& stop_requested) {
-  const ScanSource& source = ScanAt(scans, pair.source);
-  const ScanSource& target = ScanAt(scans, pair.target);
-  const Points source_points = LoadPointCloud(source.path, source.load).points;
-  const Points target_points = LoadPointCloud(target.path, target.load).points;
+  const std::shared_ptr<const ScanPyramid> source = pyramids.Get(pair.source);
+  const std::shared_ptr<const ScanPyramid> target = pyramids.Get(pair.target);
 
   BoIcpConfig config = job_config;
   config.seed = PairSeed(job_config.seed, pair);
@@ -36,8 +24,10 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
   const std::optional<Transform> guess = std::abs(pair.source - pair.target) == 1
                                              ? std::optional<Transform>(Transform::Identity())
                                              : std::nullopt;
-  out.registration = RegisterPair(source_points, target_points, config, PairPrior(source, target),
-                                  callbacks, guess);
+  out.registration = RegisterPair(
+      *source, *target, config,
+      PairPrior(scans[static_cast<size_t>(pair.source)], scans[static_cast<size_t>(pair.target)]),
+      callbacks, guess);
   return out;
 }
 

@@ -60,7 +60,9 @@ class PairScheduler {
         store_(store),
         progress_(progress),
         execution_(execution),
-        num_scans_(static_cast<int>(scans.size())) {}
+        num_scans_(static_cast<int>(scans.size())),
+        // Pairs in flight share scans with the next pairs out of the queue.
+        pyramids_(scans, config, static_cast<size_t>(std::max(execution.max_in_flight, 1)) + 2) {}
 
   RegisteredPairs Run() {
     LoadStored();
@@ -240,7 +242,7 @@ class PairScheduler {
       completion.stopped = true;
     } else {
       try {
-        const BatchPairResult result = RegisterBatchPair(scans_, pair, config_, stop);
+        const BatchPairResult result = RegisterBatchPair(scans_, pair, config_, pyramids_, stop);
         store_.Save(pair, order, result);
         completion.finished = FinishedFromResult(pair, result);
       } catch (const Cancelled&) {
@@ -283,6 +285,7 @@ class PairScheduler {
   MapProgressSink& progress_;
   const PairExecution& execution_;
   const int num_scans_;
+  ScanPyramidCache pyramids_;  // shared by the pair tasks
 
   // Used on the scheduling thread only.
   std::map<PairIndex, FinishedPair> finished_;

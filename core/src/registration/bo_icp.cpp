@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <utility>
 
 #include "boicp/registration/auto_settings.hpp"
@@ -51,8 +52,8 @@ Attempt AttemptOf(AttemptKind kind, const BoIcpConfig& config, const SearchOutco
 
 // Budget::kFixed: the paper's search, then for a doubtful answer a wider
 // refinement and a 6-DOF search; the better fit at the finest level is kept.
-Registered RegisterFixed(const Points& source, const Points& target, const BoIcpConfig& config,
-                         const std::optional<Transform>& prior,
+Registered RegisterFixed(const ScanPyramid& source, const ScanPyramid& target,
+                         const BoIcpConfig& config, const std::optional<Transform>& prior,
                          const RegistrationCallbacks& callbacks) {
   Registered out;
   const auto search = [&](const BoIcpConfig& attempt_config) {
@@ -157,7 +158,7 @@ std::vector<Transform> FeatureGuesses(const PreparedPair& prepared, const BoIcpC
 // finest points.
 class Ladder {
  public:
-  Ladder(const Points& source, const Points& target, const BoIcpConfig& config,
+  Ladder(const ScanPyramid& source, const ScanPyramid& target, const BoIcpConfig& config,
          const std::optional<Transform>& prior, const RegistrationCallbacks& callbacks)
       : source_(source),
         target_(target),
@@ -281,8 +282,8 @@ class Ladder {
     return {std::move(kept_), rung_, std::move(attempts_)};
   }
 
-  const Points& source_;
-  const Points& target_;
+  const ScanPyramid& source_;
+  const ScanPyramid& target_;
   const BoIcpConfig& config_;
   const std::optional<Transform>& prior_;
   const RegistrationCallbacks& callbacks_;
@@ -329,21 +330,16 @@ std::string AttemptKindName(AttemptKind kind) {
   return "search";
 }
 
-RegistrationResult RegisterPair(const Points& source, const Points& target,
-                                const BoIcpConfig& requested, const std::optional<Transform>& prior,
-                                const RegistrationCallbacks& callbacks,
-                                const std::optional<Transform>& guess) {
-  const auto started = std::chrono::steady_clock::now();
-  BoIcpConfig config = requested;
-  std::vector<std::string> auto_fields;
-  if (!config.automatic.empty()) {
-    auto_fields =
-        ApplyChosenSettings(ChooseSettingsForClouds({&source, &target}, CloudFormat::kAuto,
-                                                    config.seed, 2, config.threads),
-                            config);
-  }
-  ValidateConfig(config);
+namespace {
 
+// The registration proper, once the settings are final and both scans are
+// cropped and downsampled.
+RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& target,
+                                 const BoIcpConfig& config, const std::optional<Transform>& prior,
+                                 const RegistrationCallbacks& callbacks,
+                                 const std::optional<Transform>& guess,
+                                 std::chrono::steady_clock::time_point started) {
+  ValidateConfig(config);
   Registered registered = config.budget == Budget::kFixed
                               ? RegisterFixed(source, target, config, prior, callbacks)
                               : Ladder(source, target, config, prior, callbacks).Run(guess);
@@ -371,9 +367,42 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   result.history = std::move(kept.history);
   result.attempts = std::move(registered.attempts);
   result.config = config;
-  result.auto_fields = std::move(auto_fields);
   result.runtime_s = SecondsSince(started);
   return result;
+}
+
+}  // namespace
+
+RegistrationResult RegisterPair(const Points& source, const Points& target,
+                                const BoIcpConfig& requested, const std::optional<Transform>& prior,
+                                const RegistrationCallbacks& callbacks,
+                                const std::optional<Transform>& guess) {
+  const auto started = std::chrono::steady_clock::now();
+  BoIcpConfig config = requested;
+  std::vector<std::string> auto_fields;
+  if (!config.automatic.empty()) {
+    auto_fields =
+        ApplyChosenSettings(ChooseSettingsForClouds({&source, &target}, CloudFormat::kAuto,
+                                                    config.seed, 2, config.threads),
+                            config);
+  }
+  ValidateConfig(config);
+  RegistrationResult result =
+      RegisterScans(BuildScanPyramid(source, config), BuildScanPyramid(target, config), config,
+                    prior, callbacks, guess, started);
+  result.auto_fields = std::move(auto_fields);
+  return result;
+}
+
+RegistrationResult RegisterPair(const ScanPyramid& source, const ScanPyramid& target,
+                                const BoIcpConfig& config, const std::optional<Transform>& prior,
+                                const RegistrationCallbacks& callbacks,
+                                const std::optional<Transform>& guess) {
+  if (!config.automatic.empty()) {
+    throw std::invalid_argument("RegisterPair on scan pyramids needs settings chosen beforehand");
+  }
+  return RegisterScans(source, target, config, prior, callbacks, guess,
+                       std::chrono::steady_clock::now());
 }
 
 }  // namespace boicp

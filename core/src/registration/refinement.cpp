@@ -1,11 +1,11 @@
 #include "boicp/registration/refinement.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "boicp/registration/preprocess.hpp"
@@ -32,20 +32,15 @@ double AngularResolutionDeg(const Points& cloud, double voxel) {
   return rms_radius > 0.0 ? std::atan(voxel / rms_radius) * 180.0 / M_PI : 180.0;
 }
 
-// One level of one cloud, from the cloud already cropped to the range limits.
-Points DownsampleCropped(const Points& cropped, double voxel, const char* which) {
-  Points sampled = VoxelDownsample(cropped, voxel);
+}  // namespace
+
+Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
+  Points sampled = VoxelDownsample(CropByRange(raw, config.min_range, config.max_range), voxel);
   if (sampled.size() < 3) {
     throw InputError(std::string(which) + " cloud has " + std::to_string(sampled.size()) +
                      " points after cropping and downsampling (need at least 3)");
   }
   return sampled;
-}
-
-}  // namespace
-
-Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
-  return DownsampleCropped(CropByRange(raw, config.min_range, config.max_range), voxel, which);
 }
 
 IcpOptions SearchIcpOptions(const BoIcpConfig& config) {
@@ -65,19 +60,56 @@ IcpOptions SearchIcpOptions(const BoIcpConfig& config) {
   return options;
 }
 
-PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config,
-                         std::optional<uint64_t> level_seed) {
+std::vector<double> PyramidVoxels(const BoIcpConfig& config) {
   std::vector<double> voxels = {config.voxel};
   for (double voxel : RefinementVoxels(config.voxel, config.EffectiveRefineVoxel())) {
     voxels.push_back(voxel);
   }
+  return voxels;
+}
+
+ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config) {
+  ScanPyramid scan{config.min_range,
+                   config.max_range,
+                   CropByRange(raw, config.min_range, config.max_range),
+                   PyramidVoxels(config),
+                   {}};
+  scan.levels.resize(scan.voxels.size());
+  ParallelFor(scan.voxels.size(), config.threads, [&](size_t level) {
+    scan.levels[level] = VoxelDownsample(scan.cropped, scan.voxels[level]);
+  });
+  return scan;
+}
+
+PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config,
+                         std::optional<uint64_t> level_seed) {
+  return PreparePair(BuildScanPyramid(source, config), BuildScanPyramid(target, config), config,
+                     level_seed);
+}
+
+PreparedPair PreparePair(const ScanPyramid& source, const ScanPyramid& target,
+                         const BoIcpConfig& config, std::optional<uint64_t> level_seed) {
+  for (const ScanPyramid* scan : {&source, &target}) {
+    if (scan->min_range != config.min_range || scan->max_range != config.max_range) {
+      throw std::invalid_argument("a scan pyramid cut to other range limits than the pair's");
+    }
+  }
+  const std::vector<double> voxels = PyramidVoxels(config);
+  // The scan's own level when it has this voxel, else one downsampled now.
+  const auto level_of = [](const ScanPyramid& scan, double voxel, const char* which) {
+    const auto held = std::find(scan.voxels.begin(), scan.voxels.end(), voxel);
+    Points level = held != scan.voxels.end()
+                       ? scan.levels[static_cast<size_t>(held - scan.voxels.begin())]
+                       : VoxelDownsample(scan.cropped, voxel);
+    if (level.size() < 3) {
+      throw InputError(std::string(which) + " cloud has " + std::to_string(level.size()) +
+                       " points after cropping and downsampling (need at least 3)");
+    }
+    return level;
+  };
   // Every cloud of every level is independent of the others, so they are
   // built at once on the registration's threads; the search level's source
   // keeps every point, the finer ones at most refine_source_points.
-  std::array<Points, 2> cropped;  // source, target
-  ParallelFor(2, config.threads, [&](size_t which) {
-    cropped[which] = CropByRange(which == 0 ? source : target, config.min_range, config.max_range);
-  });
   std::vector<Points> sources(voxels.size());
   std::vector<std::optional<NearestNeighborIndex>> targets(voxels.size());
   ParallelFor(2 * voxels.size(), config.threads, [&](size_t task) {
@@ -85,14 +117,14 @@ PreparedPair PreparePair(const Points& source, const Points& target, const BoIcp
     if (task % 2 == 1) {
       // Every search evaluation queries the search level's target; the finer
       // ones serve a few refinement runs, too few to pay for neighbour lists.
-      targets[level].emplace(DownsampleCropped(cropped[1], voxels[level], "target"),
+      targets[level].emplace(level_of(target, voxels[level], "target"),
                              /*neighbour_lists=*/level == 0);
     } else if (level == 0) {
-      sources[level] = DownsampleCropped(cropped[0], voxels[level], "source");
+      sources[level] = level_of(source, voxels[level], "source");
     } else {
-      sources[level] = RandomSubsample(DownsampleCropped(cropped[0], voxels[level], "source"),
-                                       config.refine_source_points,
-                                       level_seed.value_or(config.seed) ^ kLevelSalt);
+      sources[level] =
+          RandomSubsample(level_of(source, voxels[level], "source"), config.refine_source_points,
+                          level_seed.value_or(config.seed) ^ kLevelSalt);
     }
   });
   PreparedPair pair{std::move(sources[0]), std::move(*targets[0]), {}, {}};
@@ -126,15 +158,16 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   // level until its steps are below 1/1000 voxel and 1e-4 rad (the search's
   // 1/100 voxel and 1e-3 rad cost the bunny 0.2-0.5 degrees and one flipped
   // pair). The ladder jumps along the steps ICP creeps by, which lets it stop
-  // the finest level at 3/1000 voxel and 3e-4 rad, and the levels before it
-  // at the search's precision, since they only hand a start to the next.
+  // every level at 3/1000 voxel and 3e-4 rad. Stopping the levels before the
+  // finest at the search's precision saved little more, and cost a flagged
+  // miss: a wrong answer whose rival was lost on the way looked certain.
   const bool ladder = config.budget == Budget::kAuto;
   options.extrapolate = ladder;
   // The search level first, then the pyramid, finest last.
   const auto run_level = [&](const Points& source, const NearestNeighborIndex& target, double voxel,
-                             double gate, bool finest) {
+                             double gate) {
     options.max_correspondence_distance = gate;
-    const double precision = !ladder ? 1e-3 : finest ? 3e-3 : 1e-2;
+    const double precision = ladder ? 3e-3 : 1e-3;
     options.convergence_translation = precision * voxel;
     options.convergence_rotation = precision / 10.0;
     options.truncation = 1.5 * voxel;
@@ -167,11 +200,9 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
                      [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
     alive = std::move(survivors);
   };
-  run_level(pair.search_source, pair.search_target, config.voxel, 1.5 * config.voxel,
-            /*finest=*/false);
+  run_level(pair.search_source, pair.search_target, config.voxel, 1.5 * config.voxel);
   for (const PyramidLevel& level : pair.pyramid) {
-    run_level(level.source, level.target, level.voxel, 3.0 * level.voxel,
-              /*finest=*/&level == &pair.pyramid.back());
+    run_level(level.source, level.target, level.voxel, 3.0 * level.voxel);
   }
   const PyramidLevel& finest = pair.pyramid.back();
   std::vector<AlignmentScore> scores;

@@ -381,8 +381,8 @@ void StagedSearch::Run(bool short_budget) {
   last_ = &second_;
 }
 
-SearchOutcome SearchAndRefine(const Points& source, const Points& target, const BoIcpConfig& config,
-                              const std::optional<Transform>& prior,
+SearchOutcome SearchAndRefine(const ScanPyramid& source, const ScanPyramid& target,
+                              const BoIcpConfig& config, const std::optional<Transform>& prior,
                               const RegistrationCallbacks& callbacks) {
   const auto prepared = std::make_shared<const PreparedPair>(PreparePair(source, target, config));
   const PairContext pair = MakePairContext(*prepared, config);

@@ -126,8 +126,8 @@ class StagedSearch {
 
 // One whole search from the pair's own prepared clouds, its
 // refine_candidates best distinct ends refined and assessed.
-SearchOutcome SearchAndRefine(const Points& source, const Points& target, const BoIcpConfig& config,
-                              const std::optional<Transform>& prior,
+SearchOutcome SearchAndRefine(const ScanPyramid& source, const ScanPyramid& target,
+                              const BoIcpConfig& config, const std::optional<Transform>& prior,
                               const RegistrationCallbacks& callbacks);
 
 // A doubtful answer may be a basin that only looked best on coarse voxels

@@ -11,6 +11,7 @@
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/mapping/pose_graph.hpp"
+#include "boicp/mapping/scan_pyramid_cache.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
 
@@ -21,14 +22,16 @@ struct BatchPairResult {
   uint64_t seed = 0;                // the pair's seed, PairSeed(job seed, pair)
 };
 
-/// Loads scans[pair.source] and scans[pair.target] and runs BO-ICP with
-/// `job_config` but seed PairSeed(job_config.seed, pair), centred on
-/// PairPrior when both scans have a prior pose; scans adjacent in the batch
-/// get identity as the ladder's guess (RegisterPair). Throws Cancelled when
-/// `stop_requested` fires, InputError when a scan does not load (or an
-/// index is out of range), std::runtime_error for engine failures.
+/// Takes scans[pair.source] and scans[pair.target] from `pyramids` (a cache
+/// over `scans` built with `job_config`) and runs BO-ICP with `job_config`
+/// but seed PairSeed(job_config.seed, pair), centred on PairPrior when both
+/// scans have a prior pose; scans adjacent in the batch get identity as the
+/// ladder's guess (RegisterPair). job_config's settings must be final
+/// (ApplyBatchSettings). Throws Cancelled when `stop_requested` fires,
+/// InputError when a scan does not load (or an index is out of range),
+/// std::runtime_error for engine failures.
 BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                                  const BoIcpConfig& job_config,
+                                  const BoIcpConfig& job_config, ScanPyramidCache& pyramids,
                                   const std::function<bool()>& stop_requested = {});
 
 /// Which map settings a batch leaves to be chosen from its scans.

@@ -15,6 +15,8 @@
 
 namespace boicp {
 
+struct ScanPyramid;  // refinement.hpp
+
 /// One ICP run started by the search. A run that reached the end of an
 /// earlier converged run (BoIcpConfig::join_converged_runs) reports that end
 /// and its objective.
@@ -147,6 +149,17 @@ struct RegistrationCallbacks {
 RegistrationResult RegisterPair(const Points& source, const Points& target,
                                 const BoIcpConfig& config,
                                 const std::optional<Transform>& prior = std::nullopt,
+                                const RegistrationCallbacks& callbacks = {},
+                                const std::optional<Transform>& guess = std::nullopt);
+
+/// The same for scans cropped and downsampled beforehand (BuildScanPyramid
+/// with this config), which pairs that share a scan share: the same answer
+/// as RegisterPair on the raw scans. runtime_s leaves out building the
+/// pyramids. Throws std::invalid_argument when config.automatic is not
+/// empty (the settings must be chosen first) or a pyramid was cut to other
+/// range limits.
+RegistrationResult RegisterPair(const ScanPyramid& source, const ScanPyramid& target,
+                                const BoIcpConfig& config, const std::optional<Transform>& prior,
                                 const RegistrationCallbacks& callbacks = {},
                                 const std::optional<Transform>& guess = std::nullopt);
 

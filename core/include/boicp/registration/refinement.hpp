@@ -33,6 +33,25 @@ struct PyramidLevel {
   NearestNeighborIndex target;  // every point at this voxel
 };
 
+/// One scan cropped to [config.min_range, config.max_range] and downsampled
+/// at every voxel of a pair's pyramid: built once per scan, it serves every
+/// pair the scan is in (a drive's scan is in two), since downsampling the
+/// same points at the same voxel gives the same cloud.
+struct ScanPyramid {
+  double min_range = 0.0, max_range = 0.0;  // the range limits `cropped` was cut to, metres
+  Points cropped;                           // the raw scan within the range limits
+  std::vector<double> voxels;               // metres: the search voxel, then the refinement levels
+  std::vector<Points> levels;               // `cropped` downsampled at each of `voxels`
+};
+
+/// The voxels of config's pyramid: config.voxel, then halving from
+/// config.voxel / 2 down to the refinement voxel (finest last).
+std::vector<double> PyramidVoxels(const BoIcpConfig& config);
+
+/// `raw` cropped and downsampled at every one of PyramidVoxels(config), the
+/// levels built on config.threads threads.
+ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config);
+
 /// Both clouds of a pair at the search voxel and at every refinement level,
 /// built once per pair.
 struct PreparedPair {
@@ -52,6 +71,16 @@ struct PreparedPair {
 /// config.seed), so two searches with different seeds can share their finest
 /// points and compare their answers on them.
 PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config,
+                         std::optional<uint64_t> level_seed = std::nullopt);
+
+/// The same from scans' pyramids: a level the pyramid holds at the voxel
+/// config asks for is used as it is, any other (a retry's coarser search
+/// voxel) is downsampled from the pyramid's cropped scan. The answer is the
+/// one PreparePair gives for the scans' raw points. Throws
+/// std::invalid_argument when a pyramid was cropped to other range limits
+/// than config's.
+PreparedPair PreparePair(const ScanPyramid& source, const ScanPyramid& target,
+                         const BoIcpConfig& config,
                          std::optional<uint64_t> level_seed = std::nullopt);
 
 /// A refined transform (T_target_source) and how well it fits at the finest
