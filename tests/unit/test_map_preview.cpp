@@ -88,6 +88,26 @@ TEST(MapPreview, ColoursByHeightWithTrajectoryMarks) {
   EXPECT_TRUE(red);
 }
 
+// The longer side is the size asked for, whatever the map's extent: its
+// scale is that size over the extent, and extent times scale can round up.
+TEST(MapPreview, TheLongerSideIsTheSizeAskedFor) {
+  PreviewOptions options;
+  options.size_px = 300;
+  for (int k = 1; k <= 400; ++k) {
+    const double length = 3.0 + 0.0731 * k;
+    OccupiedCells cells;
+    cells.resolution = 0.1;
+    for (double x : {0.05, length - 0.05}) {
+      cells.centres.emplace_back(x, 0.05, 0.0);
+      cells.sizes.push_back(0.1);
+    }
+    cells.centres.emplace_back(1.0, 1.0, 0.5);
+    cells.sizes.push_back(0.1);
+    const RgbImage image = RenderTopDown(cells, {}, options);
+    ASSERT_EQ(image.width, 300) << "map " << length << " m long";
+  }
+}
+
 TEST(MapPreview, LooksDownAlongTheGivenUp) {
   // The floor-and-wall room as a depth camera's frame holds it: the room's
   // up (z) becomes +y there, its y becomes -z.

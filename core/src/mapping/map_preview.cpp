@@ -148,9 +148,11 @@ RgbImage RenderTopDown(const OccupiedCells& cells, const Points& trajectory,
   const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-3);
   // The map gets the longer side minus a margin and the colour bar's strip.
   const int margin = options.size_px / 40 + 4, bar = options.size_px / 32 + 6;
-  const double scale = (options.size_px - 2 * margin - bar - margin) / extent.maxCoeff();
-  const int map_w = static_cast<int>(std::ceil(extent.x() * scale));
-  const int map_h = static_cast<int>(std::ceil(extent.y() * scale));
+  const int room = options.size_px - 2 * margin - bar - margin;
+  const double scale = room / extent.maxCoeff();
+  // extent * (room / extent) may round to a hair above room.
+  const int map_w = std::min(room, static_cast<int>(std::ceil(extent.x() * scale)));
+  const int map_h = std::min(room, static_cast<int>(std::ceil(extent.y() * scale)));
   const int width = map_w + 3 * margin + bar;
   const int height = std::max(map_h, 64) + 2 * margin;
   Canvas canvas(width, height);
