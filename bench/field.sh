@@ -28,7 +28,7 @@ while [ $# -gt 0 ]; do
 done
 mkdir -p "$OUT"
 PAIRS="$DATA_ROOT/kitti00/pairs.csv,$DATA_ROOT/7scenes_redkitchen/pairs.csv,$DATA_ROOT/bunny/pairs.csv"
-for condition in clean sector quarter far-returns tilt; do
+for condition in clean sector quarter far-returns tilt far-origin geo-origin; do
   "$BIN" --methods "$METHODS" --seed "$SEED" --threads "$THREADS" --auto-settings \
     --pairs "$PAIRS" --field "$condition" --out "$OUT/$condition" > "$OUT/$condition.log" 2>&1
 done

@@ -14,15 +14,21 @@ constexpr double kFarReturnNearest = 15.0;  // RMS radii
 constexpr double kFarReturnFarthest = 40.0;
 constexpr double kSectorRad = M_PI / 2;
 constexpr double kTiltRad = 25.0 * M_PI / 180.0;
+const Point kFarOrigin(800.0, -600.0, 20.0);
+const Point kGeoOrigin(452000.0, 5411000.0, 250.0);  // a UTM easting and northing
 
 struct Named {
   FieldCondition condition;
   const char* name;
 };
 constexpr Named kConditions[] = {
-    {FieldCondition::kClean, "clean"},   {FieldCondition::kFarReturns, "far-returns"},
-    {FieldCondition::kSector, "sector"}, {FieldCondition::kQuarter, "quarter"},
+    {FieldCondition::kClean, "clean"},
+    {FieldCondition::kFarReturns, "far-returns"},
+    {FieldCondition::kSector, "sector"},
+    {FieldCondition::kQuarter, "quarter"},
     {FieldCondition::kTilt, "tilt"},
+    {FieldCondition::kFarOrigin, "far-origin"},
+    {FieldCondition::kGeoOrigin, "geo-origin"},
 };
 
 // Returns through a window or an open door: directions uniform on the
@@ -95,6 +101,12 @@ FieldPair ApplyFieldCondition(FieldCondition condition, Points source, Points ta
     case FieldCondition::kTilt:
       out.source_motion.topLeftCorner<3, 3>() =
           Eigen::AngleAxisd(kTiltRad, Eigen::Vector3d::UnitX()).toRotationMatrix();
+      break;
+    case FieldCondition::kFarOrigin:
+    case FieldCondition::kGeoOrigin:
+      out.source_motion.topRightCorner<3, 1>() =
+          condition == FieldCondition::kFarOrigin ? kFarOrigin : kGeoOrigin;
+      out.target_motion = out.source_motion;
       break;
   }
   out.source = TransformPoints(out.source_motion, source);

@@ -14,7 +14,7 @@ import csv
 import os
 import sys
 
-CONDITIONS = ["clean", "sector", "quarter", "far-returns", "tilt"]
+CONDITIONS = ["clean", "sector", "quarter", "far-returns", "tilt", "far-origin", "geo-origin"]
 
 
 def read(path):

@@ -47,7 +47,9 @@ MethodOutput Refined(const Transform& initial, const FeatureCloud& source,
   const BoIcpConfig config = DatasetTableConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
   MethodOutput output;
-  output.transform = RefineCoarseToFine({initial}, pair, config).transform;
+  const Transform centred = CentredTransform(pair.source_centre, pair.target_centre, initial);
+  output.transform = UncentredTransform(pair.source_centre, pair.target_centre,
+                                        RefineCoarseToFine({centred}, pair, config).transform);
   output.evaluations = 1;
   output.source_points = source.cloud->points_.size();
   output.target_points = target.cloud->points_.size();

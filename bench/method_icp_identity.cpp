@@ -10,11 +10,14 @@ namespace boicp::bench {
 MethodOutput RunIcpFromIdentity(const MethodInput& input) {
   const BoIcpConfig config = DatasetTableConfig("C", input);
   const PreparedPair pair = PreparePair(input.source, input.target, config);
-  const Transform coarse = AlignPointToPoint(pair.search_source, pair.search_target,
-                                             Transform::Identity(), SearchIcpOptions(config))
-                               .transform;
+  const Transform identity =
+      CentredTransform(pair.source_centre, pair.target_centre, Transform::Identity());
+  const Transform coarse =
+      AlignPointToPoint(pair.search_source, pair.search_target, identity, SearchIcpOptions(config))
+          .transform;
   MethodOutput output;
-  output.transform = RefineCoarseToFine({coarse}, pair, config).transform;
+  output.transform = UncentredTransform(pair.source_centre, pair.target_centre,
+                                        RefineCoarseToFine({coarse}, pair, config).transform);
   output.evaluations = 1;
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();

@@ -173,7 +173,8 @@ MethodOutput RunPyramid(const MethodInput& input) {
   }
 
   MethodOutput output;
-  output.transform = RefineCoarseToFine({best}, pair, config).transform;
+  output.transform = UncentredTransform(pair.source_centre, pair.target_centre,
+                                        RefineCoarseToFine({best}, pair, config).transform);
   output.evaluations = scorer.evaluations() + static_cast<int>(translations.size());
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();

@@ -11,12 +11,13 @@ PairEvaluator::PairEvaluator(const BenchPair& pair, const DatasetSettings& setti
     : source_(VoxelDownsample(pair.source, settings.voxel / 3.0)),
       target_(VoxelDownsample(pair.target, settings.voxel / 3.0)),
       expected_(pair.expected),
+      error_point_(pair.error_point),
       settings_(settings) {}
 
 PairMetrics PairEvaluator::Evaluate(const Transform& estimate) const {
   PairMetrics m;
   m.rot_err_deg = RotationErrorDeg(estimate, expected_);
-  m.trans_err_m = TranslationErrorM(estimate, expected_);
+  m.trans_err_m = TranslationErrorM(estimate, expected_, error_point_);
   m.success = m.rot_err_deg < settings_.max_rot_deg && m.trans_err_m < settings_.max_trans_m;
 
   const Eigen::Matrix3d R = estimate.topLeftCorner<3, 3>();

@@ -27,6 +27,7 @@ class PairEvaluator {
   Points source_;
   NearestNeighborIndex target_;
   Transform expected_;
+  Point error_point_;
   const DatasetSettings& settings_;
 };
 

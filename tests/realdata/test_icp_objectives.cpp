@@ -65,12 +65,15 @@ TEST_P(IcpObjectives, PointToPlaneReachesTheSameBasinsInFewerIterations) {
     const Points& source = prepared.search_source;
     const NearestNeighborIndex& target = prepared.search_target;
     const Points& normals = prepared.search_target_normals;
-    const Transform start = PerturbedStart(pair.T_target_source, dataset.voxel, rng);
+    // The clouds are centred, and so is the reference between them.
+    const Transform reference =
+        CentredTransform(prepared.source_centre, prepared.target_centre, pair.T_target_source);
+    const Transform start = PerturbedStart(reference, dataset.voxel, rng);
     const IcpResult point = AlignPointToPoint(source, target, start, options);
     const IcpResult plane = AlignPointToPlane(source, target, normals, start, options);
     const auto reached = [&](const IcpResult& icp) {
-      return RotationErrorDeg(icp.transform, pair.T_target_source) < 2.0 &&
-             TranslationErrorM(icp.transform, pair.T_target_source) < dataset.voxel;
+      return RotationErrorDeg(icp.transform, reference) < 2.0 &&
+             TranslationErrorM(icp.transform, reference) < dataset.voxel;
     };
     point_reached += reached(point);
     plane_reached += reached(plane);
@@ -79,10 +82,10 @@ TEST_P(IcpObjectives, PointToPlaneReachesTheSameBasinsInFewerIterations) {
     plane_iterations += plane.iterations;
     std::printf("%-28s point %2d it %6.2f deg %7.4f m   plane %2d it %6.2f deg %7.4f m\n",
                 std::filesystem::path(pair.source).filename().c_str(), point.iterations,
-                RotationErrorDeg(point.transform, pair.T_target_source),
-                TranslationErrorM(point.transform, pair.T_target_source), plane.iterations,
-                RotationErrorDeg(plane.transform, pair.T_target_source),
-                TranslationErrorM(plane.transform, pair.T_target_source));
+                RotationErrorDeg(point.transform, reference),
+                TranslationErrorM(point.transform, reference), plane.iterations,
+                RotationErrorDeg(plane.transform, reference),
+                TranslationErrorM(plane.transform, reference));
   }
   std::printf("%s: point-to-point reached %d/%zu in %d iterations, point-to-plane %d/%zu in %d\n",
               dataset.name.c_str(), point_reached, pairs.size(), point_iterations, plane_reached,

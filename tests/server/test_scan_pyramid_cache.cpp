@@ -60,6 +60,7 @@ TEST_F(ScanPyramidCacheTest, ServesEachScansPyramidAndBuildsADroppedOneAgainTheS
   const std::shared_ptr<const ScanPyramid> first = cache.Get(1);
   const ScanPyramid built = BuildScanPyramid(Raw(1), config_);
   ASSERT_EQ(first->levels.size(), built.levels.size());
+  EXPECT_EQ(first->centre, built.centre);
   for (size_t k = 0; k < built.levels.size(); ++k) EXPECT_EQ(first->levels[k], built.levels[k]);
   EXPECT_EQ(cache.Get(1), first);  // kept: the same object
   cache.Get(2);

@@ -1,9 +1,11 @@
 #pragma once
-// Helpers the test suites share: reading a file whole, spotting staging files
-// an atomic write left behind, and running a command as a script would, with
-// its output captured. Header-only, so every test target can include it.
+// Helpers the test suites share: a scratch folder per test, reading a file
+// whole, spotting staging files an atomic write left behind, and running a
+// command as a script would, with its output captured. Header-only, so every
+// test target can include it.
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -11,7 +13,36 @@
 #include <iterator>
 #include <string>
 
+#include <gtest/gtest.h>
+
 namespace boicp::test {
+
+/// A new folder under the system's temporary directory, named after the
+/// running test and this process, and removed with its contents when the
+/// object goes.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& prefix) {
+    std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    for (char& c : test) {
+      if (c == '/') c = '_';  // a parameterised test's name
+    }
+    path_ = std::filesystem::temp_directory_path() /
+            (prefix + "_" + std::to_string(::getpid()) + "_" + test);
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 inline std::string Slurp(const std::filesystem::path& path) {
   std::ifstream file(path);

@@ -35,6 +35,24 @@ TEST(PairInformation, IsTheMatchedPointsInertiaAndVanishesWithoutOverlap) {
   EXPECT_TRUE(none.isZero());
 }
 
+// RegisterPair measures the information on centred clouds; moved back to
+// the scans' frames it is what the scans' own points give.
+TEST(PairInformation, MovedInformationIsThatOfTheMovedTargetPoints) {
+  const Points world = MakeSyntheticStreet(3, 10.0);
+  const Transform T = PoseFromYawTranslation(0.1, {0.5, -0.2, 0.0});
+  const Points target = SimulateScan(world, Transform::Identity(), 20.0, 0.0, 1);
+  const Points source = TransformPoints(T.inverse(), target);
+  const Point offset(1200.0, -800.0, 35.0);
+  Transform moved_T = T;
+  moved_T.topRightCorner<3, 1>() += offset;
+  const InformationMatrix expected = PairInformation(
+      source, NearestNeighborIndex(TransformPoints(moved_T * T.inverse(), target)), moved_T, 0.3);
+  const InformationMatrix moved =
+      MovedInformation(PairInformation(source, NearestNeighborIndex(target), T, 0.3), offset);
+  EXPECT_GT(expected(3, 3), 1000.0);
+  EXPECT_TRUE(moved.isApprox(expected, 1e-9)) << moved << "\n\n" << expected;
+}
+
 // The answer's information counts the finest level's inliers, the same
 // points its fitness is the share of.
 TEST(PairInformation, RegisterPairReportsItForTheFinestLevelInliers) {

@@ -61,6 +61,8 @@ void ExpectSamePoints(const Points& expected, const Points& actual, const std::s
 }
 
 void ExpectSamePreparedPair(const PreparedPair& expected, const PreparedPair& actual) {
+  EXPECT_EQ(expected.source_centre, actual.source_centre);
+  EXPECT_EQ(expected.target_centre, actual.target_centre);
   ExpectSamePoints(expected.search_source, actual.search_source, "search source");
   ExpectSamePoints(expected.search_target.points(), actual.search_target.points(), "search target");
   ASSERT_EQ(expected.pyramid.size(), actual.pyramid.size());
@@ -112,11 +114,22 @@ KnownPair MakeKnownPair() {
   return {truth, config, PreparePair(TransformPoints(truth.inverse(), target), target, config)};
 }
 
+// Refines from `starts` given between the scans' frames, as RegisterPair
+// does: the pair's clouds are centred, and so is the refinement.
+RefinedAlignment RefineFrom(const KnownPair& known, std::vector<Transform> starts) {
+  const PreparedPair& pair = known.pair;
+  for (Transform& start : starts) {
+    start = CentredTransform(pair.source_centre, pair.target_centre, start);
+  }
+  RefinedAlignment refined = RefineCoarseToFine(starts, pair, known.config);
+  refined.transform = UncentredTransform(pair.source_centre, pair.target_centre, refined.transform);
+  return refined;
+}
+
 TEST(Refinement, RecoversATransformFromAStartInsideTheBasin) {
   const KnownPair known = MakeKnownPair();
   const Transform& truth = known.truth;
-  const RefinedAlignment refined =
-      RefineCoarseToFine({Transform::Identity()}, known.pair, known.config);
+  const RefinedAlignment refined = RefineFrom(known, {Transform::Identity()});
   EXPECT_LT(RotationAngle(refined.transform.inverse() * truth), 1e-3);
   EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
   EXPECT_GT(refined.score.fitness, 0.99);
@@ -132,7 +145,7 @@ TEST(Refinement, TheStartThatFitsBestWinsWhateverItsPlaceInTheList) {
   for (const std::vector<Transform>& starts :
        {std::vector<Transform>{Transform::Identity(), wrong},
         std::vector<Transform>{wrong, Transform::Identity()}}) {
-    const RefinedAlignment refined = RefineCoarseToFine(starts, pair, config);
+    const RefinedAlignment refined = RefineFrom(known, starts);
     EXPECT_LT(RotationAngle(refined.transform.inverse() * truth), 1e-3);
     EXPECT_LT(TranslationNorm(refined.transform.inverse() * truth), 0.01);
   }
@@ -197,10 +210,12 @@ TEST(Refinement, ResolutionIsOneRefineVoxelSeenFromTheSourcesRmsRadius) {
 
 TEST(Refinement, CloudEmptiedByCroppingIsAnInputErrorNamingIt) {
   const Points street = MakeSyntheticStreet(5, 20.0);
+  Points beyond_range = street;
+  for (Point& p : beyond_range) p.x() += 1000.0;
   BoIcpConfig config = StreetConfig();
-  config.max_range = 0.01;
+  config.max_range = 100.0;
   try {
-    PrepareCloud(street, config, config.voxel, "target");
+    PreparePair(street, beyond_range, config);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("target cloud has 0 points"), std::string::npos)

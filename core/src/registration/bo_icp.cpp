@@ -333,27 +333,39 @@ std::string AttemptKindName(AttemptKind kind) {
 namespace {
 
 // The registration proper, once the settings are final and both scans are
-// cropped and downsampled.
+// cropped, centred and downsampled. The engine works between the centred
+// clouds; the transforms it takes and gives are mapped at this boundary.
 RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& target,
                                  const BoIcpConfig& config, const std::optional<Transform>& prior,
                                  const RegistrationCallbacks& callbacks,
                                  const std::optional<Transform>& guess,
                                  std::chrono::steady_clock::time_point started) {
   ValidateConfig(config);
-  Registered registered = config.budget == Budget::kFixed
-                              ? RegisterFixed(source, target, config, prior, callbacks)
-                              : Ladder(source, target, config, prior, callbacks).Run(guess);
+  const auto centred = [&](const std::optional<Transform>& T) -> std::optional<Transform> {
+    if (!T) return std::nullopt;
+    return CentredTransform(source.centre, target.centre, *T);
+  };
+  const auto uncentred = [&](const Transform& T) {
+    return UncentredTransform(source.centre, target.centre, T);
+  };
+  const std::optional<Transform> centred_prior = centred(prior);
+  Registered registered =
+      config.budget == Budget::kFixed
+          ? RegisterFixed(source, target, config, centred_prior, callbacks)
+          : Ladder(source, target, config, centred_prior, callbacks).Run(centred(guess));
   SearchOutcome& kept = registered.kept;
   RegistrationResult result;
-  result.transform = kept.refined.transform;
+  result.transform = uncentred(kept.refined.transform);
   result.objective = kept.objective;
   result.fitness = kept.refined.score.fitness;
   result.inlier_rmse = kept.refined.score.inlier_rmse;
   const PyramidLevel& finest = kept.prepared->pyramid.back();
-  result.information = PairInformation(finest.source, finest.target, result.transform,
-                                       config.EffectiveInlierDistance());
+  result.information =
+      MovedInformation(PairInformation(finest.source, finest.target, kept.refined.transform,
+                                       config.EffectiveInlierDistance()),
+                       target.centre);
   result.overlap = kept.overlap;
-  result.search_reach = SearchReach(kept.box, result.transform);
+  result.search_reach = SearchReach(kept.box, kept.refined.transform);
   result.probability_better = kept.probability_better;
   result.features = kept.features;
   result.confidence = kept.confidence;
@@ -365,7 +377,12 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   result.source_points = kept.source_points;
   result.target_points = kept.target_points;
   result.history = std::move(kept.history);
+  for (Evaluation& evaluation : result.history) {
+    evaluation.initial = uncentred(evaluation.initial);
+    evaluation.result = uncentred(evaluation.result);
+  }
   result.attempts = std::move(registered.attempts);
+  for (Attempt& attempt : result.attempts) attempt.transform = uncentred(attempt.transform);
   result.config = config;
   result.runtime_s = SecondsSince(started);
   return result;

@@ -60,8 +60,12 @@ double RotationErrorDeg(const Transform& estimate, const Transform& reference) {
   return RotationAngle(estimate.inverse() * reference) * 180.0 / M_PI;
 }
 
-double TranslationErrorM(const Transform& estimate, const Transform& reference) {
-  return (estimate.topRightCorner<3, 1>() - reference.topRightCorner<3, 1>()).norm();
+double TranslationErrorM(const Transform& estimate, const Transform& reference, const Point& at) {
+  const Point moved_by_estimate =
+      estimate.topLeftCorner<3, 3>() * at + estimate.topRightCorner<3, 1>();
+  const Point moved_by_reference =
+      reference.topLeftCorner<3, 3>() * at + reference.topRightCorner<3, 1>();
+  return (moved_by_estimate - moved_by_reference).norm();
 }
 
 PerturbationKind ParsePerturbationKind(const std::string& name) {

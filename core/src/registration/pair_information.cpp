@@ -20,4 +20,12 @@ InformationMatrix PairInformation(const Points& source, const NearestNeighborInd
   return information;
 }
 
+InformationMatrix MovedInformation(const InformationMatrix& information, const Point& offset) {
+  InformationMatrix A = InformationMatrix::Identity();
+  A.bottomLeftCorner<3, 3>() << 0.0, offset.z(), -offset.y(),  //
+      -offset.z(), 0.0, offset.x(),                            //
+      offset.y(), -offset.x(), 0.0;
+  return A.transpose() * information * A;
+}
+
 }  // namespace boicp

@@ -34,15 +34,6 @@ double AngularResolutionDeg(const Points& cloud, double voxel) {
 
 }  // namespace
 
-Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which) {
-  Points sampled = VoxelDownsample(CropByRange(raw, config.min_range, config.max_range), voxel);
-  if (sampled.size() < 3) {
-    throw InputError(std::string(which) + " cloud has " + std::to_string(sampled.size()) +
-                     " points after cropping and downsampling (need at least 3)");
-  }
-  return sampled;
-}
-
 IcpOptions SearchIcpOptions(const BoIcpConfig& config) {
   IcpOptions options;
   options.max_correspondence_distance = config.EffectiveMaxCorrespondence();
@@ -69,16 +60,32 @@ std::vector<double> PyramidVoxels(const BoIcpConfig& config) {
 }
 
 ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config) {
-  ScanPyramid scan{config.min_range,
-                   config.max_range,
-                   CropByRange(raw, config.min_range, config.max_range),
-                   PyramidVoxels(config),
-                   {}};
+  ScanPyramid scan{config.min_range,      config.max_range,
+                   Point::Zero(),         CropByRange(raw, config.min_range, config.max_range),
+                   PyramidVoxels(config), {}};
+  if (!scan.cropped.empty()) scan.centre = Centroid(scan.cropped);
+  for (Point& p : scan.cropped) p -= scan.centre;
   scan.levels.resize(scan.voxels.size());
   ParallelFor(scan.voxels.size(), config.threads, [&](size_t level) {
     scan.levels[level] = VoxelDownsample(scan.cropped, scan.voxels[level]);
   });
   return scan;
+}
+
+Transform CentredTransform(const Point& source_centre, const Point& target_centre,
+                           const Transform& T_target_source) {
+  Transform centred = T_target_source;
+  centred.topRightCorner<3, 1>() +=
+      T_target_source.topLeftCorner<3, 3>() * source_centre - target_centre;
+  return centred;
+}
+
+Transform UncentredTransform(const Point& source_centre, const Point& target_centre,
+                             const Transform& centred) {
+  Transform T_target_source = centred;
+  T_target_source.topRightCorner<3, 1>() +=
+      target_centre - centred.topLeftCorner<3, 3>() * source_centre;
+  return T_target_source;
 }
 
 PreparedPair PreparePair(const Points& source, const Points& target, const BoIcpConfig& config,
@@ -127,7 +134,8 @@ PreparedPair PreparePair(const ScanPyramid& source, const ScanPyramid& target,
                           level_seed.value_or(config.seed) ^ kLevelSalt);
     }
   });
-  PreparedPair pair{std::move(sources[0]), std::move(*targets[0]), {}, {}};
+  PreparedPair pair{
+      source.centre, target.centre, std::move(sources[0]), std::move(*targets[0]), {}, {}};
   if (config.icp_objective == IcpObjective::kPointToPlane) {
     pair.search_target_normals =
         EstimateSurfaceNormals(pair.search_target, 3.0 * config.voxel, config.threads);

@@ -28,8 +28,10 @@ std::vector<ReferencePair> ReadPairsCsv(const std::string& path);
 /// Angle of R_est^T R_ref, in degrees.
 double RotationErrorDeg(const Transform& estimate, const Transform& reference);
 
-/// |t_est - t_ref|, metres.
-double TranslationErrorM(const Transform& estimate, const Transform& reference);
+/// |estimate * at - reference * at|, metres: the translation error at the
+/// point `at` of the source frame (its origin by default).
+double TranslationErrorM(const Transform& estimate, const Transform& reference,
+                         const Point& at = Point::Zero());
 
 enum class PerturbationKind {
   kNone,         // identity

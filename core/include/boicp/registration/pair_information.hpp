@@ -20,4 +20,11 @@ using InformationMatrix = Eigen::Matrix<double, 6, 6>;
 InformationMatrix PairInformation(const Points& source, const NearestNeighborIndex& target,
                                   const Transform& T_target_source, double max_distance);
 
+/// The information of the same matches with every target point moved by
+/// `offset` metres (q + offset): A^T * information * A with
+/// A = [I 0; -[offset]x I], exactly what PairInformation gives on the moved
+/// points. It carries an answer found on centred clouds back to the scans'
+/// frames.
+InformationMatrix MovedInformation(const InformationMatrix& information, const Point& offset);
+
 }  // namespace boicp

@@ -16,11 +16,6 @@
 
 namespace boicp {
 
-/// Crops `raw` to [config.min_range, config.max_range] and voxel-downsamples it
-/// at `voxel` metres. Throws InputError naming `which` ("source" or "target")
-/// when fewer than 3 points are left.
-Points PrepareCloud(const Points& raw, const BoIcpConfig& config, double voxel, const char* which);
-
 /// ICP settings of one search evaluation: the config's correspondence gate and
 /// iteration cap, converging once a step moves less than 1e-2 voxel and turns
 /// less than 1e-3 rad.
@@ -33,15 +28,19 @@ struct PyramidLevel {
   NearestNeighborIndex target;  // every point at this voxel
 };
 
-/// One scan cropped to [config.min_range, config.max_range] and downsampled
-/// at every voxel of a pair's pyramid: built once per scan, it serves every
-/// pair the scan is in (a drive's scan is in two), since downsampling the
-/// same points at the same voxel gives the same cloud.
+/// One scan cropped to [config.min_range, config.max_range], moved so that
+/// its centroid is at the origin, and downsampled at every voxel of a pair's
+/// pyramid: built once per scan, it serves every pair the scan is in (a
+/// drive's scan is in two), since downsampling the same points at the same
+/// voxel gives the same cloud. Centred clouds keep their precision and their
+/// ICP steps turn about the scan itself, wherever its frame's origin is (a
+/// scan exported in a site frame 10^6 m away).
 struct ScanPyramid {
   double min_range = 0.0, max_range = 0.0;  // the range limits `cropped` was cut to, metres
-  Points cropped;                           // the raw scan within the range limits
-  std::vector<double> voxels;               // metres: the search voxel, then the refinement levels
-  std::vector<Points> levels;               // `cropped` downsampled at each of `voxels`
+  Point centre = Point::Zero();  // the cropped scan's centroid, in the scan's frame (metres)
+  Points cropped;                // the raw scan within the range limits, minus `centre`
+  std::vector<double> voxels;    // metres: the search voxel, then the refinement levels
+  std::vector<Points> levels;    // `cropped` downsampled at each of `voxels`
 };
 
 /// The voxels of config's pyramid: config.voxel, then halving from
@@ -53,8 +52,12 @@ std::vector<double> PyramidVoxels(const BoIcpConfig& config);
 ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config);
 
 /// Both clouds of a pair at the search voxel and at every refinement level,
-/// built once per pair.
+/// built once per pair. Each cloud is centred (ScanPyramid): a point p of the
+/// source scan is p - source_centre here, and transforms between the two are
+/// CentredTransform and UncentredTransform.
 struct PreparedPair {
+  Point source_centre = Point::Zero();  // metres, in the source scan's frame
+  Point target_centre = Point::Zero();  // metres, in the target scan's frame
   Points search_source;
   NearestNeighborIndex search_target;
   /// Normals of search_target's points for point-to-plane evaluations
@@ -65,6 +68,13 @@ struct PreparedPair {
   /// every level starts inside the next level's basin; finest last.
   std::vector<PyramidLevel> pyramid;
 };
+
+/// T_target_source between the scans' frames, as a transform between the
+/// centred clouds, and back.
+Transform CentredTransform(const Point& source_centre, const Point& target_centre,
+                           const Transform& T_target_source);
+Transform UncentredTransform(const Point& source_centre, const Point& target_centre,
+                             const Transform& centred);
 
 /// Throws InputError when a cloud is left with fewer than 3 points at any level.
 /// The finer levels' sources are subsampled with `level_seed` (default
