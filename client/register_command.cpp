@@ -1,5 +1,6 @@
 // `boicp register`: one pair, locally, printing the transform (or JSON).
 
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -24,6 +25,7 @@ struct RegisterFlags {
   std::string intrinsics, intrinsics_file, prior_file;
   std::vector<int> invalid_depth = {0, 65535};
   double depth_scale = 0.0;
+  double scale_source = 1.0;
   settings::RequestedSettings settings;
   settings::FlagTexts setting_texts;
   bool json = false, quiet = false;
@@ -89,7 +91,13 @@ int RunRegister(const RegisterFlags& flags) {
   try {
     BoIcpConfig config = BuildConfig(flags);
     const LoadOptions load = BuildLoadOptions(flags);
-    const LoadedCloud source = LoadPointCloud(flags.source, load);
+    if (!(flags.scale_source > 0.0) || !std::isfinite(flags.scale_source)) {
+      throw InputError("--scale-source must be a positive number");
+    }
+    LoadedCloud source = LoadPointCloud(flags.source, load);
+    if (flags.scale_source != 1.0) {
+      for (Point& p : source.points) p *= flags.scale_source;
+    }
     const LoadedCloud target = LoadPointCloud(flags.target, load);
     std::optional<Transform> prior;
     if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
@@ -148,6 +156,10 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--prior", f.prior_file, "Initial guess: file with a 4x4 or 3x4 T_target_source");
+  app.add_option("--scale-source", f.scale_source,
+                 "Multiply the source's coordinates by this first (0.001: millimetres to metres "
+                 "when the target is in metres); the prior and the answer map the scaled source")
+      ->capture_default_str();
   settings::AddSettingFlags(app, settings::kRegister, f.settings, f.setting_texts);
   return [flags] { return RunRegister(*flags); };
 }

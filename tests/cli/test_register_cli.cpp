@@ -139,6 +139,39 @@ TEST_F(Cli, FarReturnsAreCountedAndDoNotMoveTheSettings) {
   }
 }
 
+// A source in millimetres against a target in metres is refused with both
+// scales and the fix named; with that fix it registers as the metre pair.
+TEST_F(Cli, ScansInOtherUnitsAreAnErrorThatScaleSourceFixes) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  std::ifstream in(dir_ / "source.xyz");
+  std::ofstream out(dir_ / "source_mm.xyz");
+  double x = 0.0, y = 0.0, z = 0.0;
+  out.precision(12);
+  while (in >> x >> y >> z) out << 1000.0 * x << " " << 1000.0 * y << " " << 1000.0 * z << "\n";
+  out.close();
+  const std::string common = "register --target " + (dir_ / "target.xyz").string() +
+                             " --config A --seed 3 --rotation-bounds 0.2,0.2,pi --json";
+  const RunResult refused = Run(common + " --source " + (dir_ / "source_mm.xyz").string());
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("differ in scale by a factor of about 1000"));
+  EXPECT_THAT(refused.err, HasSubstr("do they share units?"));
+  EXPECT_THAT(refused.err, HasSubstr("--scale-source 0.001"));
+
+  const RunResult metres = Run(common + " --source " + (dir_ / "source.xyz").string());
+  const RunResult scaled =
+      Run(common + " --scale-source 0.001 --source " + (dir_ / "source_mm.xyz").string());
+  ASSERT_EQ(metres.exit_code, 0) << metres.err;
+  ASSERT_EQ(scaled.exit_code, 0) << scaled.err;
+  const nlohmann::json a = nlohmann::json::parse(metres.out), b = nlohmann::json::parse(scaled.out);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      EXPECT_NEAR(b["transform"][i][j].get<double>(), a["transform"][i][j].get<double>(), 0.01);
+    }
+  }
+  EXPECT_EQ(Run(common + " --scale-source 0 --source " + (dir_ / "source.xyz").string()).exit_code,
+            2);
+}
+
 // The paper's search, as before the ladder: nested, (10 + 20) evaluations a
 // stage, and only the retry of a doubtful answer after it.
 TEST_F(Cli, FixedBudgetRunsThePapersSearch) {

@@ -75,6 +75,24 @@ TEST(AutoSettings, LengthsFollowTheScenesScale) {
   EXPECT_EQ(big.rotation_bounds, small.rotation_bounds);
 }
 
+// A cloud in millimetres against one in metres is not a pair of one scene
+// to choose settings for; a view ten times larger may be.
+TEST(AutoSettings, CloudsInOtherUnitsAreAnErrorNamingBothScales) {
+  const Points metres = CameraView();
+  const Points millimetres = Scaled(metres, 1000.0);
+  const Points ten_times = Scaled(metres, 10.0);
+  EXPECT_NO_THROW(ChooseSettingsForClouds({&metres, &ten_times}, CloudFormat::kAuto, 1));
+  try {
+    ChooseSettingsForClouds({&millimetres, &metres}, CloudFormat::kAuto, 1);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("differ in scale by a factor of about 1000"));
+    EXPECT_THAT(e.what(), HasSubstr("do they share units?"));
+    EXPECT_THAT(e.what(), HasSubstr("--scale-source 0.001"));
+  }
+  EXPECT_THROW(ChooseSettingsForClouds({&metres, &millimetres}, CloudFormat::kAuto, 1), InputError);
+}
+
 // 3 % of the camera's returns through a window, 60-150 m out in one
 // direction: they drag a centroid and an RMS radius, not the settings.
 TEST(AutoSettings, FarReturnsThroughAWindowAreSetAside) {

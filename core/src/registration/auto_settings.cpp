@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "boicp/registration/nearest_neighbors.hpp"
 #include "boicp/registration/preprocess.hpp"
@@ -53,6 +54,10 @@ constexpr int kPlaneTrials = 200;
 // Points measured (random, seeded): statistics of 20,000 points differ from
 // those of the whole cloud by far less than the rules' precision.
 constexpr size_t kMeasuredPoints = 20000;
+// Scans of one scene in one unit differ in extent and in point spacing by a
+// few times at most (a corridor against an open yard, a near view against a
+// far one); a factor over 20 in both is a millimetre cloud against a metre one.
+constexpr double kUnitMismatch = 20.0;
 constexpr size_t kSpacingQueries = 1000;
 // Far returns (through a window or an open door, off rain or dust) lie many
 // times farther from the scene's middle than its typical point, and a few
@@ -121,6 +126,46 @@ std::optional<double> GroundTilt(const Points& points, double tolerance, uint64_
 }
 
 double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
+
+// How many times the coordinates of `other` would have to be scaled to match
+// `first`'s scale, when both the RMS radius and the point spacing say so by
+// more than kUnitMismatch; 0 when the clouds may share units.
+double UnitMismatch(const CloudStatistics& first, const CloudStatistics& other) {
+  if (!(first.spacing > 0.0 && other.spacing > 0.0)) return 0.0;
+  const double radii = first.rms_radius / other.rms_radius;
+  const double spacings = first.spacing / other.spacing;
+  const bool larger = radii > kUnitMismatch && spacings > kUnitMismatch;
+  const bool smaller = radii < 1.0 / kUnitMismatch && spacings < 1.0 / kUnitMismatch;
+  return larger || smaller ? std::sqrt(radii * spacings) : 0.0;
+}
+
+// A factor as a user would type it: the nearest power of ten when it is
+// within a quarter of one (millimetres, centimetres, inches are not).
+std::string FactorText(double factor) {
+  const double decade = std::pow(10.0, std::round(std::log10(factor)));
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g",
+                std::abs(factor / decade - 1.0) < 0.25 ? decade : factor);
+  return text;
+}
+
+void CheckSharedUnits(const std::vector<CloudStatistics>& stats) {
+  const CloudStatistics& first = stats.front();
+  for (size_t k = 1; k < stats.size(); ++k) {
+    const double factor = UnitMismatch(first, stats[k]);
+    if (factor == 0.0) continue;
+    char scales[256];
+    std::snprintf(scales, sizeof scales,
+                  "RMS radius %.3g and point spacing %.3g in the first, %.3g and %.3g in the "
+                  "other",
+                  first.rms_radius, first.spacing, stats[k].rms_radius, stats[k].spacing);
+    throw InputError("the scans differ in scale by a factor of about " +
+                     FactorText(std::max(factor, 1.0 / factor)) + " (" + scales +
+                     "): do they share units? Convert one to the other's units (for a pair, " +
+                     "boicp register --scale-source " + FactorText(1.0 / factor) +
+                     " multiplies the source's coordinates by " + FactorText(1.0 / factor) + ")");
+  }
+}
 
 // Where far returns begin: a sphere about the coordinate-wise median point,
 // which a few percent of far points cannot drag as they drag a centroid.
@@ -216,6 +261,7 @@ CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
 
 ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format) {
   if (stats.empty()) throw InputError("automatic settings need at least one cloud");
+  CheckSharedUnits(stats);
   std::vector<double> radii, ranges, spacings, tilts;
   bool all_around = true, level = true;
   for (const CloudStatistics& s : stats) {

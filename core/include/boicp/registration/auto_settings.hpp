@@ -54,6 +54,9 @@ struct ChosenSettings {
 
 /// The settings for clouds measured by `stats` (at least one), read in
 /// `format` (kAuto when unknown: the sensor then comes from the geometry).
+/// Throws InputError, naming both scales, when a cloud's RMS radius and point
+/// spacing both differ from the first cloud's by more than 20 times (a
+/// millimetre cloud against a metre one).
 ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format);
 
 /// Measures up to `max_clouds` of `clouds`, evenly spread (a batch's settings
