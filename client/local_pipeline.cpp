@@ -149,6 +149,8 @@ void ChooseRunSettings(LocalRun& run) {
       ApplyBatchSettings(run.folder.scans, run.config, run.map.occupancy, run.map_auto);
   run.auto_fields = std::move(choice.fields);
   run.measured = std::move(choice.measured);
+  run.sensor = choice.sensor;
+  run.sensor_reason = std::move(choice.sensor_reason);
   run.map_auto = {false, false};
   ValidateConfig(run.config);
   ValidateOccupancySettings(run.map.occupancy);
@@ -164,6 +166,10 @@ void PrintRunSettings(const LocalRun& run) {
       run.config.rotation_bounds[0], run.config.rotation_bounds[1], run.config.rotation_bounds[2],
       run.map.occupancy.resolution, run.map.occupancy.max_range,
       run.auto_fields.empty() ? "" : "; from the scans: ", JoinNames(run.auto_fields).c_str());
+  if (!run.measured.empty()) {
+    std::fprintf(stderr, "settings: sensor %s (%s)\n", SensorKindName(run.sensor).c_str(),
+                 run.sensor_reason.c_str());
+  }
   size_t far_returns = 0, scans_with_far_returns = 0;
   for (const MeasuredScan& m : run.measured) {
     far_returns += m.far_returns;
@@ -187,6 +193,9 @@ json RunManifestJson(const LocalRun& run) {
   for (const MeasuredScan& m : run.measured) {
     manifest["far_returns"].push_back(
         {{"scan", run.folder.scans[m.scan].path}, {"points", m.far_returns}});
+  }
+  if (!run.measured.empty()) {
+    manifest["sensor"] = {{"type", SensorKindName(run.sensor)}, {"why", run.sensor_reason}};
   }
   return manifest;
 }

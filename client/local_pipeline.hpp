@@ -44,12 +44,14 @@ struct LocalRun {
   ScanFolder folder;
   BoIcpConfig config;  // config.seed is the job seed; one thread per registration
   MapBuildSettings map;
-  MapAutoFields map_auto;                // map settings still to be chosen from the scans
-  std::vector<std::string> auto_fields;  // the settings ChooseRunSettings chose
-  std::vector<MeasuredScan> measured;    // the scans it chose them from
-  bool keyframes = false;                // overlap pairing
-  double overlap_threshold = 0;          // keyframes only
-  std::vector<PairIndex> plan;           // consecutive or explicit pairs; empty for keyframes
+  MapAutoFields map_auto;                  // map settings still to be chosen from the scans
+  std::vector<std::string> auto_fields;    // the settings ChooseRunSettings chose
+  std::vector<MeasuredScan> measured;      // the scans it chose them from
+  SensorKind sensor = SensorKind::kOther;  // the sensor it took them for, when it measured
+  std::string sensor_reason;               // and why
+  bool keyframes = false;                  // overlap pairing
+  double overlap_threshold = 0;            // keyframes only
+  std::vector<PairIndex> plan;             // consecutive or explicit pairs; empty for keyframes
 };
 
 /// Reads the folder and validates everything (config, map settings,
@@ -64,8 +66,9 @@ void ChooseRunSettings(LocalRun& run);
 void PrintRunSettings(const LocalRun& run);
 
 /// run.json: the settings as given, plus "chosen" (the settings used),
-/// "auto" (which of them came from the scans) and "far_returns" (the points
-/// of each measured scan set aside while choosing them).
+/// "auto" (which of them came from the scans), "far_returns" (the points
+/// of each measured scan set aside while choosing them) and, when scans were
+/// measured, "sensor" ({"type", "why"}: the sensor the settings assumed).
 nlohmann::json RunManifestJson(const LocalRun& run);
 
 /// "source,target" index pairs, one a line ('#' comments, blank lines and a

@@ -110,7 +110,7 @@ int RunRegister(const RegisterFlags& flags) {
                    "loaded %zu source and %zu target points (%zu and %zu non-finite dropped)\n",
                    source.points.size(), target.points.size(), source.dropped_nonfinite,
                    target.dropped_nonfinite);
-      std::fprintf(stderr, "%s\n", DescribeSettings(config, auto_fields, chosen.sensor).c_str());
+      std::fprintf(stderr, "%s\n", DescribeSettings(config, auto_fields, chosen).c_str());
       if (chosen.far_returns[0] + chosen.far_returns[1] > 0) {
         std::fprintf(stderr,
                      "%zu source and %zu target points set aside as far returns when choosing "
@@ -123,6 +123,7 @@ int RunRegister(const RegisterFlags& flags) {
     if (flags.json) {
       nlohmann::json out = RegistrationToJson(result, auto_fields);
       out["far_returns"] = {{"source", chosen.far_returns[0]}, {"target", chosen.far_returns[1]}};
+      out["sensor"] = {{"type", SensorKindName(chosen.sensor)}, {"why", chosen.sensor_reason}};
       std::cout << out.dump() << std::endl;
     } else {
       PrintHuman(result);

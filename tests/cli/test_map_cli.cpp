@@ -362,6 +362,10 @@ TEST_F(MapCli, FarReturnsAreListedInRunJson) {
               "scan00" + std::to_string(i) + ".xyz");
     EXPECT_EQ(entry["points"], i == 1 ? added : 0u) << "scan " << i;
   }
+  // The sensor the settings assumed, and why: the far returns do not hide the ring.
+  EXPECT_EQ(manifest["sensor"]["type"], "lidar");
+  EXPECT_THAT(manifest["sensor"]["why"].get<std::string>(), HasSubstr("ring covering 360 deg"));
+  EXPECT_THAT(r.err, HasSubstr("settings: sensor lidar (ring covering 360 deg"));
   const std::vector<Transform> poses = ReadKittiTrajectory((out / "trajectory.kitti").string());
   ASSERT_EQ(poses.size(), 3u);
   for (size_t i = 0; i < 3; ++i) {

@@ -88,6 +88,10 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
     EXPECT_TRUE(j["config"].contains(name.get<std::string>())) << name << " names no setting";
   }
   EXPECT_EQ(j["far_returns"], nlohmann::json({{"source", 0}, {"target", 0}}));
+  // The generated street is a full ring of a LiDAR 1.8 m above the road.
+  EXPECT_EQ(j["sensor"]["type"], "lidar");
+  EXPECT_THAT(j["sensor"]["why"].get<std::string>(), HasSubstr("ring covering 360 deg"));
+  EXPECT_THAT(j["sensor"]["why"].get<std::string>(), HasSubstr("m below the origin"));
   EXPECT_FALSE(j["doubtful"].get<bool>());
   // The answer lies inside its search box.
   EXPECT_GE(j["search_reach"].get<double>(), 0.0);

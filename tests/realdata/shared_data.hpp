@@ -1,6 +1,7 @@
 #pragma once
 // Where the real-data tests find ../shared/data, and how its scans load.
 
+#include <cctype>
 #include <filesystem>
 #include <string>
 
@@ -29,6 +30,14 @@ inline LoadOptions SharedDataLoadOptions(const std::filesystem::path& folder, bo
     load.depth.depth_scale = 1000.0;
   }
   return load;
+}
+
+/// `name` as a test name: every character but letters and digits becomes '_'.
+inline std::string TestName(std::string name) {
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
 }
 
 }  // namespace boicp

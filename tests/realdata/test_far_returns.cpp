@@ -77,11 +77,7 @@ INSTANTIATE_TEST_SUITE_P(SharedData, FarReturns,
                                            ScanDataset{"7scenes_redkitchen", true},
                                            ScanDataset{"bunny", false}),
                          [](const ::testing::TestParamInfo<ScanDataset>& info) {
-                           std::string name = info.param.name;
-                           for (char& c : name) {
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           }
-                           return name;
+                           return TestName(info.param.name);
                          });
 
 }  // namespace

@@ -94,11 +94,7 @@ INSTANTIATE_TEST_SUITE_P(SharedData, OriginFree,
                                            OriginCase{"7scenes_redkitchen", true, 2.0, 0.05},
                                            OriginCase{"bunny", false, 2.0, 0.005}),
                          [](const ::testing::TestParamInfo<OriginCase>& info) {
-                           std::string name = info.param.name;
-                           for (char& c : name) {
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           }
-                           return name;
+                           return TestName(info.param.name);
                          });
 
 }  // namespace

@@ -94,12 +94,8 @@ INSTANTIATE_TEST_SUITE_P(SharedData, RealPairs,
                          ::testing::Combine(::testing::ValuesIn(Datasets()),
                                             ::testing::Values(Budget::kAuto, Budget::kFixed)),
                          [](const ::testing::TestParamInfo<std::tuple<DatasetCase, Budget>>& info) {
-                           std::string name = std::get<0>(info.param).name + "_" +
-                                              BudgetName(std::get<1>(info.param));
-                           for (char& c : name) {
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           }
-                           return name;
+                           return TestName(std::get<0>(info.param).name + "_" +
+                                           BudgetName(std::get<1>(info.param)));
                          });
 
 // A street scan against a kitchen: nothing fits, so every rung of the

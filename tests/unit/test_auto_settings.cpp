@@ -2,6 +2,7 @@
 // sensor's view and the user's overrides.
 
 #include <random>
+#include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -51,6 +52,46 @@ TEST(AutoSettings, LevelLidarTurnsOnlyAboutZ) {
   // The ground holds the height: z gets far less room than x and y.
   EXPECT_LT(chosen.translation_bounds.z(), 0.5 * chosen.translation_bounds.x());
   EXPECT_GT(chosen.map_max_range, 0.0);
+}
+
+Points WithoutAzimuths(const Points& points, double from_deg, double to_deg) {
+  Points kept;
+  for (const Point& p : points) {
+    const double azimuth = std::atan2(p.y(), p.x()) * 180.0 / M_PI;
+    if (azimuth < from_deg || azimuth >= to_deg) kept.push_back(p);
+  }
+  return kept;
+}
+
+// A ring with a sector blocked (an operator's back, a side mount) is still a
+// LiDAR's; with most of it blocked it is a view, and the reason says which.
+TEST(AutoSettings, TheSensorSaysWhyAndARingWithAGapIsARing) {
+  const Points scan = StreetScan();
+  const ChosenSettings full = ChooseSettingsForClouds({&scan, &scan}, CloudFormat::kAuto, 1);
+  EXPECT_EQ(full.sensor, SensorKind::kLidar);
+  EXPECT_THAT(full.sensor_reason, HasSubstr("ring covering 360 deg"));
+  // The sensor is 1.8 m up; the plane is found within half a search voxel.
+  const size_t ground = full.sensor_reason.find("ground plane ");
+  ASSERT_NE(ground, std::string::npos) << full.sensor_reason;
+  EXPECT_NEAR(std::stod(full.sensor_reason.substr(ground + 13)), 1.8, 0.5 * full.voxel);
+  EXPECT_THAT(full.sensor_reason, HasSubstr("m below the origin"));
+
+  const Points blocked = WithoutAzimuths(scan, -60.0, 40.0);  // 100 degrees behind an operator
+  const ChosenSettings gap = ChooseSettingsForClouds({&scan, &blocked}, CloudFormat::kAuto, 1);
+  EXPECT_EQ(gap.sensor, SensorKind::kLidar);
+  EXPECT_EQ(gap.rotation_bounds, full.rotation_bounds);
+  EXPECT_THAT(gap.sensor_reason, HasSubstr("ring covering 260 deg"));
+
+  const Points half = WithoutAzimuths(scan, -90.0, 90.0);
+  const ChosenSettings view = ChooseSettingsForClouds({&scan, &half}, CloudFormat::kAuto, 1);
+  EXPECT_NE(view.sensor, SensorKind::kLidar);
+  EXPECT_THAT(view.sensor_reason, HasSubstr("one-sided view"));
+
+  const Points camera = CameraView();
+  EXPECT_THAT(ChooseSettingsForClouds({&camera}, CloudFormat::kAuto, 1).sensor_reason,
+              HasSubstr("one-sided view (mean direction 0."));
+  EXPECT_EQ(ChooseSettingsForClouds({&camera}, CloudFormat::kDepthPng, 1).sensor_reason,
+            "depth images");
 }
 
 TEST(AutoSettings, ConeOfViewMayTurnAnyhow) {

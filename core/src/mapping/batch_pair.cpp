@@ -53,6 +53,8 @@ BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoI
   // Every loaded cloud is measured, in order (max_clouds = their number).
   const ChosenSettings chosen = ChooseSettingsForClouds(pointers, format, config.seed, count);
   for (size_t k = 0; k < count; ++k) choice.measured[k].far_returns = chosen.far_returns[k];
+  choice.sensor = chosen.sensor;
+  choice.sensor_reason = chosen.sensor_reason;
   choice.fields = ApplyChosenSettings(chosen, config);
   if (map_auto.resolution) {
     occupancy.resolution = chosen.map_resolution;

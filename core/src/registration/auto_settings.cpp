@@ -40,9 +40,13 @@ constexpr double kConeTranslationPerRadius = 1.0;
 constexpr double kAllAroundTranslationPerRadius = 0.25;
 constexpr double kMinTranslationBoundVoxels = 2.0;
 // A spinning LiDAR sees every side of its origin; a depth camera or a scanner
-// of objects sees one cone.
+// of objects sees one cone, which makes their directions from the origin
+// alike (a mean unit direction over 0.5), whatever their azimuths. A ring
+// with up to a third of it blocked (an operator's back, a side mount, a
+// vehicle's own body) is still a ring: points over 240 degrees of azimuth
+// have a mean direction of 0.41 at most.
 constexpr int kAzimuthSectors = 36;
-constexpr int kAllAroundSectors = 32;
+constexpr int kAllAroundSectors = 24;
 constexpr double kMaxAllAroundDirection = 0.5;  // norm of the mean unit direction
 // Ground: the largest plane below the origin, holding at least a sixth of the
 // points, with its normal within 15 degrees of +z. A car's roll and pitch then
@@ -67,16 +71,15 @@ constexpr size_t kSpacingQueries = 1000;
 // end), 4 (a 7-Scenes room) and 3 (the bunny).
 constexpr double kFarReturnMedians = 12.0;
 
-bool SeesAllAround(const Points& points) {
-  // A cone of view (a camera's, or an object seen from one side) has its
-  // directions from the origin mostly alike, whatever their azimuths.
-  Eigen::Vector3d mean_direction = Eigen::Vector3d::Zero();
+double MeanDirection(const Points& points) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const Point& p : points) {
-    if (p.norm() > 0.0) mean_direction += p.normalized();
+    if (p.norm() > 0.0) sum += p.normalized();
   }
-  if (mean_direction.norm() > kMaxAllAroundDirection * static_cast<double>(points.size())) {
-    return false;
-  }
+  return points.empty() ? 0.0 : sum.norm() / static_cast<double>(points.size());
+}
+
+double AzimuthCoverageDeg(const Points& points) {
   std::vector<bool> seen(kAzimuthSectors, false);
   for (const Point& p : points) {
     const double azimuth = std::atan2(p.y(), p.x()) + M_PI;  // [0, 2 pi]
@@ -84,13 +87,18 @@ bool SeesAllAround(const Points& points) {
         std::min(kAzimuthSectors - 1, static_cast<int>(azimuth / (2.0 * M_PI) * kAzimuthSectors));
     seen[static_cast<size_t>(sector)] = true;
   }
-  return std::count(seen.begin(), seen.end(), true) >= kAllAroundSectors;
+  return 360.0 * static_cast<double>(std::count(seen.begin(), seen.end(), true)) / kAzimuthSectors;
 }
 
+struct GroundPlane {
+  double tilt = 0.0;   // radians between its normal and +z
+  double depth = 0.0;  // metres from the origin down to it
+};
+
 // RANSAC (seeded) for the near-horizontal plane with the most points within
-// `tolerance` metres. Returns the angle between its normal and +z when it
-// holds kMinGroundShare of the points and lies below the origin.
-std::optional<double> GroundTilt(const Points& points, double tolerance, uint64_t seed) {
+// `tolerance` metres. Returns it when it holds kMinGroundShare of the points
+// and lies below the origin.
+std::optional<GroundPlane> FindGround(const Points& points, double tolerance, uint64_t seed) {
   if (points.size() < 3) return std::nullopt;
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
@@ -122,7 +130,7 @@ std::optional<double> GroundTilt(const Points& points, double tolerance, uint64_
       best_offset <= 0.0) {
     return std::nullopt;
   }
-  return std::acos(std::min(1.0, best_normal.z()));
+  return GroundPlane{std::acos(std::min(1.0, best_normal.z())), best_offset};
 }
 
 double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
@@ -147,6 +155,40 @@ std::string FactorText(double factor) {
   std::snprintf(text, sizeof text, "%.4g",
                 std::abs(factor / decade - 1.0) < 0.25 ? decade : factor);
   return text;
+}
+
+// Why ChooseSettings took the sensor it took, in the words of its rules:
+// the format when that decides, else the least all-around of the clouds;
+// then, for a LiDAR, the ground its rotation box relies on.
+std::string SensorReason(const std::vector<CloudStatistics>& stats, CloudFormat format,
+                         SensorKind sensor, bool level) {
+  const auto least_around = std::min_element(
+      stats.begin(), stats.end(), [](const CloudStatistics& a, const CloudStatistics& b) {
+        return std::make_pair(a.all_around, -a.mean_direction) <
+               std::make_pair(b.all_around, -b.mean_direction);
+      });
+  char text[160];
+  if (format == CloudFormat::kKittiBin) {
+    std::snprintf(text, sizeof text, "KITTI .bin scans (a spinning LiDAR)");
+  } else if (format == CloudFormat::kDepthPng) {
+    std::snprintf(text, sizeof text, "depth images");
+  } else if (least_around->mean_direction > kMaxAllAroundDirection) {
+    std::snprintf(text, sizeof text, "one-sided view (mean direction %.2f)",
+                  least_around->mean_direction);
+  } else {
+    std::snprintf(text, sizeof text, "ring covering %.0f deg", least_around->azimuth_coverage_deg);
+    if (!least_around->all_around) {
+      return std::string(text) + " (a LiDAR's covers 240 or more)";
+    }
+  }
+  std::string reason = text;
+  if (sensor != SensorKind::kLidar) return reason;
+  if (!level) return reason + ", no ground plane below the origin in every scan";
+  std::vector<double> depths;
+  for (const CloudStatistics& s : stats) depths.push_back(s.ground_depth);
+  std::snprintf(text, sizeof text, ", ground plane %.2f m below the origin",
+                Median(std::move(depths)));
+  return reason + text;
 }
 
 void CheckSharedUnits(const std::vector<CloudStatistics>& stats) {
@@ -253,9 +295,16 @@ CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
   }
   stats.range_p95 = Percentile(ranges, 0.95);
   stats.spacing = PointSpacing(cloud, seed);
-  stats.all_around = SeesAllAround(points);
+  stats.mean_direction = MeanDirection(points);
+  stats.azimuth_coverage_deg = AzimuthCoverageDeg(points);
+  stats.all_around = stats.mean_direction <= kMaxAllAroundDirection &&
+                     stats.azimuth_coverage_deg >= kAllAroundSectors * (360.0 / kAzimuthSectors);
   const double voxel = stats.rms_radius / kRadiusPerVoxel;
-  stats.ground_tilt = GroundTilt(VoxelDownsample(points, voxel / 2), voxel / 2, seed + 1);
+  if (const std::optional<GroundPlane> ground =
+          FindGround(VoxelDownsample(points, voxel / 2), voxel / 2, seed + 1)) {
+    stats.ground_tilt = ground->tilt;
+    stats.ground_depth = ground->depth;
+  }
   return stats;
 }
 
@@ -279,6 +328,7 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFo
   } else if (format == CloudFormat::kDepthPng) {
     chosen.sensor = SensorKind::kDepthCamera;
   }
+  chosen.sensor_reason = SensorReason(stats, format, chosen.sensor, level);
   chosen.voxel = Median(radii) / kRadiusPerVoxel;
   chosen.point_spacing = Median(spacings);
   const double radius = Median(radii);
@@ -348,23 +398,23 @@ std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcp
 namespace boicp {
 
 std::string DescribeSettings(const BoIcpConfig& config, const std::vector<std::string>& auto_fields,
-                             SensorKind sensor) {
+                             const ChosenSettings& chosen) {
   const auto mark = [&](const std::string& field) {
     return std::find(auto_fields.begin(), auto_fields.end(), field) != auto_fields.end() ? " (auto)"
                                                                                          : "";
   };
-  char text[512];
+  char text[768];
   std::snprintf(text, sizeof text,
-                "preset %s, %s search, sensor %s: voxel %.3g m%s, refine voxel %.3g m%s, "
+                "preset %s, %s search, sensor %s (%s): voxel %.3g m%s, refine voxel %.3g m%s, "
                 "translation bounds %.3g,%.3g,%.3g m%s, rotation bounds %.3g,%.3g,%.3g rad%s, "
                 "%d threads, seed %llu",
                 config.preset.c_str(), SearchModeName(config.mode).c_str(),
-                SensorKindName(sensor).c_str(), config.voxel, mark("voxel"),
-                config.EffectiveRefineVoxel(), mark("refine_voxel"), config.translation_bounds[0],
-                config.translation_bounds[1], config.translation_bounds[2],
-                mark("translation_bounds"), config.rotation_bounds[0], config.rotation_bounds[1],
-                config.rotation_bounds[2], mark("rotation_bounds"), config.threads,
-                static_cast<unsigned long long>(config.seed));
+                SensorKindName(chosen.sensor).c_str(), chosen.sensor_reason.c_str(), config.voxel,
+                mark("voxel"), config.EffectiveRefineVoxel(), mark("refine_voxel"),
+                config.translation_bounds[0], config.translation_bounds[1],
+                config.translation_bounds[2], mark("translation_bounds"), config.rotation_bounds[0],
+                config.rotation_bounds[1], config.rotation_bounds[2], mark("rotation_bounds"),
+                config.threads, static_cast<unsigned long long>(config.seed));
   return text;
 }
 

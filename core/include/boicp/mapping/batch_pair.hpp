@@ -51,6 +51,8 @@ struct MeasuredScan {
 struct BatchSettingsChoice {
   std::vector<std::string> fields;  // names of the fields it set
   std::vector<MeasuredScan> measured;
+  SensorKind sensor = SensorKind::kOther;  // what the settings assumed, when measured
+  std::string sensor_reason;               // why (ChosenSettings::sensor_reason)
 };
 
 /// Chooses, once for the whole batch, the fields of `config` still in

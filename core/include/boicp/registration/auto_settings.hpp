@@ -27,10 +27,16 @@ struct CloudStatistics {
   double rms_radius = 0.0;  // RMS distance from the centroid, metres
   double range_p95 = 0.0;   // 95th percentile of the distance from the sensor origin, metres
   double spacing = 0.0;     // median distance from a point to its nearest other point, metres
-  bool all_around = false;  // points on every side of the origin (a spinning LiDAR)
+  /// Points on most sides of the origin (a spinning LiDAR, also with a
+  /// sector blocked): directions that do not share one cone (mean_direction
+  /// at most 0.5) over at least 240 degrees of azimuth.
+  bool all_around = false;
+  double azimuth_coverage_deg = 0.0;  // azimuth about z holding points, in 10-degree sectors
+  double mean_direction = 0.0;        // norm of the mean unit direction from the origin, [0, 1]
   /// Angle (radians) between +z and the normal of a ground plane below the
   /// origin that holds a large share of the points; nullopt when none is found.
   std::optional<double> ground_tilt;
+  double ground_depth = 0.0;  // metres from the origin down to that plane (0 without one)
 };
 
 /// Measures `cloud` (metres, sensor frame). Random choices use `seed`.
@@ -43,6 +49,9 @@ constexpr size_t kMinPointsForSettings = 100;
 /// Every setting automatic mode chooses, with the sensor it assumed.
 struct ChosenSettings {
   SensorKind sensor = SensorKind::kOther;
+  /// Why, for the user: "ring covering 350 deg, ground plane 1.73 m below
+  /// the origin", "one-sided view (mean direction 0.83)", ...
+  std::string sensor_reason;
   double voxel = 0.0;          // metres, search voxel for preset C (truncation follows it)
   double point_spacing = 0.0;  // metres; with the voxel, sets the refinement voxel
   Eigen::Vector3d translation_bounds = Eigen::Vector3d::Zero();  // metres
@@ -72,9 +81,10 @@ ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
 /// kAutoRegistrationFields order.
 std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcpConfig& config);
 
-/// One line for the user: preset, search mode, sensor, and the voxel,
-/// refinement voxel and boxes, each marked "(auto)" when in `auto_fields`.
+/// One line for the user: preset, search mode, the sensor and why, and the
+/// voxel, refinement voxel and boxes, each marked "(auto)" when in
+/// `auto_fields`.
 std::string DescribeSettings(const BoIcpConfig& config, const std::vector<std::string>& auto_fields,
-                             SensorKind sensor);
+                             const ChosenSettings& chosen);
 
 }  // namespace boicp
