@@ -43,8 +43,8 @@ constexpr double kMinTranslationBoundVoxels = 2.0;
 // of objects sees one cone, which makes their directions from the origin
 // alike (a mean unit direction over 0.5), whatever their azimuths. A ring
 // with up to a third of it blocked (an operator's back, a side mount, a
-// vehicle's own body) is still a ring: points over 240 degrees of azimuth
-// have a mean direction of 0.41 at most.
+// vehicle's own body) is still a ring: points spread evenly over 240
+// degrees of azimuth have a mean direction of 0.41.
 constexpr int kAzimuthSectors = 36;
 constexpr int kAllAroundSectors = 24;
 constexpr double kMaxAllAroundDirection = 0.5;  // norm of the mean unit direction

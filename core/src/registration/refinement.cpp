@@ -60,11 +60,13 @@ std::vector<double> PyramidVoxels(const BoIcpConfig& config) {
 }
 
 ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config) {
-  ScanPyramid scan{config.min_range,      config.max_range,
-                   Point::Zero(),         CropByRange(raw, config.min_range, config.max_range),
-                   PyramidVoxels(config), {}};
+  ScanPyramid scan;
+  scan.min_range = config.min_range;
+  scan.max_range = config.max_range;
+  scan.cropped = CropByRange(raw, config.min_range, config.max_range);
   if (!scan.cropped.empty()) scan.centre = Centroid(scan.cropped);
   for (Point& p : scan.cropped) p -= scan.centre;
+  scan.voxels = PyramidVoxels(config);
   scan.levels.resize(scan.voxels.size());
   ParallelFor(scan.voxels.size(), config.threads, [&](size_t level) {
     scan.levels[level] = VoxelDownsample(scan.cropped, scan.voxels[level]);
