@@ -80,10 +80,8 @@ BenchPair LoadPair(const DatasetPairs& dataset, size_t index, uint64_t seed) {
       LoadPointCloud(reference.target, load).points, PairSeed(dataset, index, seed) ^ kFieldSalt);
   BenchPair pair =
       PerturbPair(dataset, index, seed, std::move(field.source), std::move(field.target));
-  pair.expected = field.target_motion * reference.T_target_source * field.source_motion.inverse() *
-                  pair.perturbation.inverse();
-  pair.error_point =
-      pair.perturbation.topLeftCorner<3, 3>() * field.source_motion.topRightCorner<3, 1>();
+  pair.expected = field.Expected(reference.T_target_source, pair.perturbation);
+  pair.error_point = field.ErrorPoint(pair.perturbation);
   return pair;
 }
 

@@ -22,12 +22,8 @@ struct BenchPair {
   Points target;
   Transform perturbation = Transform::Identity();  // P
   Transform expected = Transform::Identity();      // T_ref * P^-1: maps `source` onto `target`
-  // Where the translation error is measured, in `source`'s frame: the
-  // source's own origin as a field condition moved it, rotated by P (0 for a
-  // clean pair), so that scans moved 1 km from their frame's origin do not
-  // read a right answer's 0.1 degrees as metres.
-  Point error_point = Point::Zero();
-  uint64_t method_seed = 0;  // the seed every method uses on this pair
+  Point error_point = Point::Zero();  // where the translation error is measured (FieldPair)
+  uint64_t method_seed = 0;           // the seed every method uses on this pair
 };
 
 /// A perturbation P = Trans(t) * Rot: Rot drawn as settings.perturb says (yaw

@@ -81,6 +81,15 @@ std::string FieldConditionNames() {
   return names;
 }
 
+Transform FieldPair::Expected(const Transform& T_target_source,
+                              const Transform& perturbation) const {
+  return target_motion * T_target_source * source_motion.inverse() * perturbation.inverse();
+}
+
+Point FieldPair::ErrorPoint(const Transform& perturbation) const {
+  return perturbation.topLeftCorner<3, 3>() * source_motion.topRightCorner<3, 1>();
+}
+
 FieldPair ApplyFieldCondition(FieldCondition condition, Points source, Points target,
                               uint64_t seed) {
   std::mt19937_64 rng(seed);

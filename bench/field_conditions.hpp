@@ -32,11 +32,20 @@ struct FieldPair {
   Points source, target;
   Transform source_motion = Transform::Identity();  // p -> source_motion * p
   Transform target_motion = Transform::Identity();
+
+  /// T_target_source of these scans with the source moved by `perturbation`
+  /// P afterwards, from the clean pair's T: target_motion * T *
+  /// source_motion^-1 * P^-1.
+  Transform Expected(const Transform& T_target_source, const Transform& perturbation) const;
+  /// Where the translation error is measured in the perturbed source's frame:
+  /// the source's own origin as the condition moved it, rotated by P (0 for
+  /// a clean pair), so that scans 1 km from their frame's origin do not read
+  /// a right answer's 0.1 degrees as metres.
+  Point ErrorPoint(const Transform& perturbation) const;
 };
 
 /// Applies `condition` to a loaded pair; the random choices (which points,
-/// which sector, where the extra returns go) follow `seed`. The reference
-/// T_target_source of the result is target_motion * T * source_motion^-1.
+/// which sector, where the extra returns go) follow `seed`.
 FieldPair ApplyFieldCondition(FieldCondition condition, Points source, Points target,
                               uint64_t seed);
 

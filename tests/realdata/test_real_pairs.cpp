@@ -59,15 +59,12 @@ void ExpectDatasetRecovered(const DatasetCase& dataset, Budget budget,
                                    LoadPointCloud(pair.target, load).points, field_rng());
     const Transform perturbation = RandomPerturbation(dataset.perturbation, rng);
     const Points source = TransformPoints(perturbation, field.source);
-    const Transform expected = field.target_motion * pair.T_target_source *
-                               field.source_motion.inverse() * perturbation.inverse();
-    // Translation errors at the source's own origin, wherever the condition moved it.
-    const Point origin =
-        perturbation.topLeftCorner<3, 3>() * (field.source_motion.topRightCorner<3, 1>());
+    const Transform expected = field.Expected(pair.T_target_source, perturbation);
     config.seed = rng();
     const RegistrationResult result = RegisterPair(source, field.target, config);
     const double rot = RotationErrorDeg(result.transform, expected);
-    const double trans = TranslationErrorM(result.transform, expected, origin);
+    const double trans =
+        TranslationErrorM(result.transform, expected, field.ErrorPoint(perturbation));
     const bool ok = rot < dataset.max_rotation_deg && trans < dataset.max_translation_m;
     successes += ok;
     doubtful += result.doubtful;
