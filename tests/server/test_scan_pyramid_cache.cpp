@@ -82,12 +82,12 @@ TEST_F(ScanPyramidCacheTest, ThreadsAskingForOneScanShareOneBuild) {
 }
 
 TEST_F(ScanPyramidCacheTest, ABatchPairFromTheCacheIsThePairFromTheRawScans) {
-  ScanPyramidCache cache(scans_, config_, 2);
   for (const Budget budget : {Budget::kAuto, Budget::kFixed}) {
     BoIcpConfig config = config_;
     config.budget = budget;
     config.random_samples = 8;
     config.iterations = 8;
+    ScanPyramidCache cache(scans_, config, 2);
     for (const PairIndex pair : {PairIndex{0, 1}, PairIndex{1, 2}, PairIndex{0, 2}}) {
       const BatchPairResult cached = RegisterBatchPair(scans_, pair, config, cache);
       BoIcpConfig raw_config = config;
@@ -103,10 +103,15 @@ TEST_F(ScanPyramidCacheTest, ABatchPairFromTheCacheIsThePairFromTheRawScans) {
       EXPECT_EQ(cached.registration.evaluations, raw.evaluations);
     }
   }
+  ScanPyramidCache cache(scans_, config_, 2);
+  const std::shared_ptr<const ScanPyramid> scan = cache.Get(0);
   BoIcpConfig automatic = config_;
   automatic.automatic = {"voxel"};
-  const std::shared_ptr<const ScanPyramid> scan = cache.Get(0);
   EXPECT_THROW(RegisterPair(*scan, *scan, automatic, std::nullopt), std::invalid_argument);
+  // The budgets order a pyramid's points differently (CellOrder).
+  BoIcpConfig fixed = config_;
+  fixed.budget = Budget::kFixed;
+  EXPECT_THROW(RegisterPair(*scan, *scan, fixed, std::nullopt), std::invalid_argument);
 }
 
 }  // namespace

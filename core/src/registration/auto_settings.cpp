@@ -300,8 +300,10 @@ CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
   stats.all_around = stats.mean_direction <= kMaxAllAroundDirection &&
                      stats.azimuth_coverage_deg >= kAllAroundSectors * (360.0 / kAzimuthSectors);
   const double voxel = stats.rms_radius / kRadiusPerVoxel;
+  // The settings serve both budgets, and the fixed budget's answers depend on
+  // the order of the points the ground's seeded draws pick from.
   if (const std::optional<GroundPlane> ground =
-          FindGround(VoxelDownsample(points, voxel / 2), voxel / 2, seed + 1)) {
+          FindGround(VoxelDownsample(points, voxel / 2, CellOrder::kOpen3d), voxel / 2, seed + 1)) {
     stats.ground_tilt = ground->tilt;
     stats.ground_depth = ground->depth;
   }

@@ -59,17 +59,22 @@ std::vector<double> PyramidVoxels(const BoIcpConfig& config) {
   return voxels;
 }
 
+CellOrder PyramidCellOrder(const BoIcpConfig& config) {
+  return config.budget == Budget::kFixed ? CellOrder::kOpen3d : CellOrder::kFirstReached;
+}
+
 ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config) {
   ScanPyramid scan;
   scan.min_range = config.min_range;
   scan.max_range = config.max_range;
+  scan.order = PyramidCellOrder(config);
   scan.cropped = CropByRange(raw, config.min_range, config.max_range);
   if (!scan.cropped.empty()) scan.centre = Centroid(scan.cropped);
   for (Point& p : scan.cropped) p -= scan.centre;
   scan.voxels = PyramidVoxels(config);
   scan.levels.resize(scan.voxels.size());
   ParallelFor(scan.voxels.size(), config.threads, [&](size_t level) {
-    scan.levels[level] = VoxelDownsample(scan.cropped, scan.voxels[level]);
+    scan.levels[level] = VoxelDownsample(scan.cropped, scan.voxels[level], scan.order);
   });
   return scan;
 }
@@ -102,6 +107,9 @@ PreparedPair PreparePair(const ScanPyramid& source, const ScanPyramid& target,
     if (scan->min_range != config.min_range || scan->max_range != config.max_range) {
       throw std::invalid_argument("a scan pyramid cut to other range limits than the pair's");
     }
+    if (scan->order != PyramidCellOrder(config)) {
+      throw std::invalid_argument("a scan pyramid built for the other budget");
+    }
   }
   const std::vector<double> voxels = PyramidVoxels(config);
   // The scan's own level when it has this voxel, else one downsampled now.
@@ -109,7 +117,7 @@ PreparedPair PreparePair(const ScanPyramid& source, const ScanPyramid& target,
     const auto held = std::find(scan.voxels.begin(), scan.voxels.end(), voxel);
     Points level = held != scan.voxels.end()
                        ? scan.levels[static_cast<size_t>(held - scan.voxels.begin())]
-                       : VoxelDownsample(scan.cropped, voxel);
+                       : VoxelDownsample(scan.cropped, voxel, scan.order);
     if (level.size() < 3) {
       throw InputError(std::string(which) + " cloud has " + std::to_string(level.size()) +
                        " points after cropping and downsampling (need at least 3)");

@@ -11,10 +11,22 @@ namespace boicp {
 /// max_range] metres. max_range <= 0 means no upper limit.
 Points CropByRange(const Points& points, double min_range, double max_range);
 
+/// The order in which VoxelDownsample returns its cells.
+enum class CellOrder {
+  /// The order in which the cloud first reaches each cell: a scan's
+  /// neighbouring cells stay near each other in memory.
+  kFirstReached,
+  /// Open3D's hash-map order. The fixed budget's answers depend on it through
+  /// their seeded subsamples, and keep them.
+  kOpen3d,
+};
+
 /// Replaces the points in each cubic voxel of edge `voxel` metres by their
-/// centroid: the points of Open3D's VoxelDownSample, in its order. voxel <= 0
-/// returns the input unchanged.
-Points VoxelDownsample(const Points& points, double voxel);
+/// centroid: the points of Open3D's VoxelDownSample, bit for bit, in `order`.
+/// voxel <= 0 returns the input unchanged. Throws InputError when the cloud
+/// spans more cells than an int counts.
+Points VoxelDownsample(const Points& points, double voxel,
+                       CellOrder order = CellOrder::kFirstReached);
 
 /// At most `max_points` points chosen uniformly without replacement, in their
 /// original order; reproducible for a given seed. max_points == 0 or

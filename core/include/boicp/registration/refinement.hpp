@@ -12,6 +12,7 @@
 #include "boicp/registration/config.hpp"
 #include "boicp/registration/icp.hpp"
 #include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/registration/preprocess.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -36,7 +37,8 @@ struct PyramidLevel {
 /// ICP steps turn about the scan itself, wherever its frame's origin is (a
 /// scan exported in a site frame 10^6 m away).
 struct ScanPyramid {
-  double min_range = 0.0, max_range = 0.0;  // the range limits `cropped` was cut to, metres
+  double min_range = 0.0, max_range = 0.0;     // the range limits `cropped` was cut to, metres
+  CellOrder order = CellOrder::kFirstReached;  // of every level's points
   Point centre = Point::Zero();  // the cropped scan's centroid, in the scan's frame (metres)
   Points cropped;                // the raw scan within the range limits, minus `centre`
   std::vector<double> voxels;    // metres: the search voxel, then the refinement levels
@@ -46,6 +48,10 @@ struct ScanPyramid {
 /// The voxels of config's pyramid: config.voxel, then halving from
 /// config.voxel / 2 down to the refinement voxel (finest last).
 std::vector<double> PyramidVoxels(const BoIcpConfig& config);
+
+/// The order of a pyramid's points: Open3D's for the fixed budget, whose
+/// answers depend on it, and the faster first-reached order for the ladder.
+CellOrder PyramidCellOrder(const BoIcpConfig& config);
 
 /// `raw` cropped and downsampled at every one of PyramidVoxels(config), the
 /// levels built on config.threads threads.
