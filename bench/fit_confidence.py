@@ -46,6 +46,9 @@ FEATURES = {
     "kResolutionDeg": lambda row: float(row["resolution_deg"]),
 }
 RECORDED = {"confidence": lambda row: float(row["confidence"])}
+# The engine trusts an answer at most in proportion to its fitness below this
+# (kFitnessOfFullTrust in confidence.cpp); predictions apply the same cap.
+FITNESS_OF_FULL_TRUST = 0.1
 RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
 
 
@@ -86,7 +89,8 @@ def fit_logistic(x, y):
 
 
 def predict(w, x):
-    return 1.0 / (1.0 + np.exp(-(w[0] + x @ w[1:])))
+    model = 1.0 / (1.0 + np.exp(-(w[0] + x @ w[1:])))
+    return np.minimum(model, np.maximum(x[:, 0], 0.0) / FITNESS_OF_FULL_TRUST)
 
 
 def auroc(scores, labels):

@@ -21,7 +21,7 @@ ConfidenceFeatures Features(double fitness, double margin, double resolution_deg
 TEST(Confidence, MonotoneInFitness) {
   for (double margin : {0.0, 0.1, 1.0}) {
     for (double resolution : {0.1, 1.0}) {
-      double previous = 0.0;
+      double previous = -1.0;
       for (double fitness = 0.0; fitness <= 1.0; fitness += 0.05) {
         const double c = Confidence(Features(fitness, margin, resolution));
         EXPECT_GT(c, previous) << fitness << " " << margin << " " << resolution;
@@ -35,15 +35,29 @@ TEST(Confidence, MonotoneInFitness) {
 // trusted, at any resolution; nor is a weak fit without a runner-up.
 TEST(Confidence, NoInliersOrAWeakLoneAnswerIsDoubtful) {
   for (double resolution : {0.05, 0.5, 2.0}) {
-    EXPECT_LT(Confidence(Features(0.0, 0.0, resolution)), kDoubtfulBelow);
+    EXPECT_EQ(Confidence(Features(0.0, 0.0, resolution)), 0.0);
     EXPECT_LT(Confidence(Features(0.2, 0.0, resolution)), kDoubtfulBelow);
+  }
+}
+
+// A street scan registered onto a room matched 0.1 % of its points, and its
+// runner-up matched a seventh of that: a wide relative margin between two
+// empty fits. Few matches are doubtful whatever the margin and resolution.
+TEST(Confidence, AnAnswerAlmostNothingMatchesIsDoubtfulWhateverItsMargin) {
+  for (double fitness : {0.001, 0.02, 0.049}) {
+    for (double margin : {0.857, 1.0}) {
+      for (double resolution : {0.0, 0.015, 0.5}) {
+        EXPECT_LT(Confidence(Features(fitness, margin, resolution)), kDoubtfulBelow)
+            << fitness << " " << margin << " " << resolution;
+      }
+    }
   }
 }
 
 TEST(Confidence, MoreInliersAndAWiderMarginAreMoreCertain) {
   EXPECT_LT(Confidence(Features(0.3, 0.5, 0.5)), Confidence(Features(0.6, 0.5, 0.5)));
   EXPECT_LT(Confidence(Features(0.3, 0.05, 0.5)), Confidence(Features(0.3, 0.6, 0.5)));
-  for (double fitness : {0.0, 0.3, 1.0}) {
+  for (double fitness : {0.01, 0.3, 1.0}) {
     const double c = Confidence(Features(fitness, 1.0, 0.2));
     EXPECT_GT(c, 0.0);
     EXPECT_LT(c, 1.0);

@@ -1,5 +1,6 @@
 #include "boicp/registration/confidence.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace boicp {
@@ -18,6 +19,12 @@ constexpr double kResolutionDeg = -6.037;
 // wrong basin, and the log tells a 2 % margin from a 15 % one where a linear
 // term barely does. The floor is about the precision of a fitness.
 constexpr double kMarginFloor = 0.01;
+// An answer that matches few of the source's points is trusted at most in
+// proportion to them, whatever the model says: between two near-empty fits
+// the margin is a ratio of noise, and with no inliers nothing supports the
+// answer. Under half this fitness an answer is always doubtful. Right
+// answers match far more (bench/README.md).
+constexpr double kFitnessOfFullTrust = 0.1;
 
 }  // namespace
 
@@ -25,7 +32,8 @@ double Confidence(const ConfidenceFeatures& f) {
   const double z = kIntercept + kFitness * f.fitness +
                    kLogMargin * std::log(f.margin + kMarginFloor) +
                    kResolutionDeg * f.resolution_deg;
-  return 1.0 / (1.0 + std::exp(-z));
+  const double model = 1.0 / (1.0 + std::exp(-z));
+  return std::min(model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust);
 }
 
 }  // namespace boicp

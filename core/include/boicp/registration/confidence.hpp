@@ -18,8 +18,9 @@ struct ConfidenceFeatures {
   double resolution_deg = 0.0;      // RefinedAlignment::resolution_deg
 };
 
-/// Estimated probability, in (0, 1), that the answer is within the success
-/// thresholds (2 degrees, and a few refinement voxels of translation).
+/// Estimated probability, in [0, 1), that the answer is within the success
+/// thresholds (2 degrees, and a few refinement voxels of translation); 0
+/// with no inliers.
 double Confidence(const ConfidenceFeatures& features);
 
 }  // namespace boicp
