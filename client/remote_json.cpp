@@ -17,6 +17,7 @@ nlohmann::json ChosenSettingsToJson(const v1::ChosenSettings& s) {
   out["map_max_range"] = s.map_max_range();
   out["auto"] = s.auto_fields();
   out["far_returns"] = s.far_returns();
+  if (!s.sensor().empty()) out["sensor"] = {{"type", s.sensor()}, {"why", s.sensor_why()}};
   return out;
 }
 
@@ -32,18 +33,19 @@ std::string DescribeChosenSettings(const v1::ChosenSettings& s) {
       s.far_returns() == 0
           ? ""
           : "; " + std::to_string(s.far_returns()) + " far returns set aside while choosing";
+  const std::string sensor =
+      s.sensor().empty() ? "" : "; sensor " + s.sensor() + " (" + s.sensor_why() + ")";
   char text[512];
   std::snprintf(text, sizeof text,
                 "preset %s, %s%s, voxel %.3g m, refine voxel %.3g m, translation bounds "
                 "%.3g,%.3g,%.3g m, rotation bounds %.3g,%.3g,%.3g rad, map resolution %.3g m, "
-                "ray length %.3g m%s%s%s",
+                "ray length %.3g m%s%s",
                 c.preset().c_str(), c.mode().c_str(), budget.c_str(), c.voxel(), c.refine_voxel(),
                 c.translation_bounds().x(), c.translation_bounds().y(), c.translation_bounds().z(),
                 c.rotation_bounds().x(), c.rotation_bounds().y(), c.rotation_bounds().z(),
                 s.map_resolution(), s.map_max_range(),
-                automatic.empty() ? "" : "; from the scans: ", automatic.c_str(),
-                far_returns.c_str());
-  return text;
+                automatic.empty() ? "" : "; from the scans: ", automatic.c_str());
+  return text + far_returns + sensor;
 }
 
 nlohmann::json JobToJson(const v1::Job& job) {

@@ -119,6 +119,10 @@ v1::ChosenSettings ChosenSettingsToProto(const BoIcpConfig& config, const MapBui
   uint64_t far_returns = 0;
   for (const MeasuredScan& m : choice.measured) far_returns += m.far_returns;
   out.set_far_returns(far_returns);
+  if (!choice.measured.empty()) {
+    out.set_sensor(SensorKindName(choice.sensor));
+    out.set_sensor_why(choice.sensor_reason);
+  }
   return out;
 }
 

@@ -195,6 +195,8 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_GT(used["voxel"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(used["map_resolution"].get<double>(), 0.3);
   EXPECT_EQ(used["far_returns"], 0);  // generated scans have none
+  EXPECT_EQ(used["sensor"]["type"], "lidar");
+  EXPECT_THAT(used["sensor"]["why"].get<std::string>(), HasSubstr("ground plane"));
   ASSERT_EQ(j["pairs"].size(), 3u);
   ASSERT_EQ(j["trajectory"].size(), 4u);
   int doubtful = 0;

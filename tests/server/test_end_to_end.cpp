@@ -174,6 +174,8 @@ TEST_F(EndToEnd, BatchToOctomapAndTrajectory) {
   EXPECT_EQ(done.pairs_doubtful(), doubtful);
   EXPECT_EQ(done.settings().config().budget(), "auto");
   EXPECT_EQ(done.settings().far_returns(), 0u);  // generated scans have none
+  EXPECT_EQ(done.settings().sensor(), "lidar");  // KITTI .bin scans
+  EXPECT_THAT(done.settings().sensor_why(), ::testing::HasSubstr("ground plane"));
 
   const fs::path bt = dir_ / "map.bt", tum = dir_ / "trajectory.tum", kit = dir_ / "traj.kitti";
   EXPECT_GT(client.ExportToFile(done.job_id(), v1::EXPORT_FORMAT_OCTOMAP_BT, bt.string()), 0u);
