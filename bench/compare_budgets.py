@@ -3,6 +3,7 @@
 `--budget fixed` against the default ladder.
 
 usage: compare_budgets.py FIXED_OUT AUTO_OUT [--truth FILE.kitti | --pairs pairs.csv]
+                          [--round FIXED_OUT AUTO_OUT ...]
 
 Reads each run's pairs.json and map.json (what `boicp map --json` printed). Prints, for each run, the ICP
 evaluations of all pairs, the wall time and the count per rung, then the
@@ -10,7 +11,10 @@ ratios, and for every pair whether the ladder's transform is within 1 cm and
 0.1 degree of the fixed run's, or else closer to the reference: the drive's
 true poses (--truth, one 3x4 row-major T_world_scan per line, as
 `boicp demo-data` writes) or a pairs.csv of reference T_target_source (the
-shared data's). Exit status 1 when some pair is neither.
+shared data's). Each --round is another pair of runs of the same folder,
+made alternately with the first: the wall-time ratio is then the median of
+every round's, and each round's transforms must equal the first's (the runs
+are seeded). Exit status 1 when some pair is neither, or a round differs.
 """
 
 import argparse
@@ -79,12 +83,35 @@ def rung_counts(pairs):
     return ", ".join(f"{n} {rung}" for rung, n in sorted(counts.items()))
 
 
+def compare_rounds(rounds, fixed, auto, first_ratio):
+    """Prints every round's wall times and the median ratio; counts the
+    rounds whose transforms differ from the first's."""
+    ratios = [first_ratio]
+    differing = 0
+    for k, (fixed_dir, auto_dir) in enumerate(rounds, start=2):
+        round_fixed, fixed_run = load_run(fixed_dir)
+        round_auto, auto_run = load_run(auto_dir)
+        ratios.append(fixed_run["runtime_s"] / auto_run["runtime_s"])
+        print(f"round {k}: wall fixed {fixed_run['runtime_s']:.1f} s, auto "
+              f"{auto_run['runtime_s']:.1f} s, {ratios[-1]:.1f}x")
+        for first, again in ((fixed, round_fixed), (auto, round_auto)):
+            if any(again.get(key, {}).get("transform") != p["transform"]
+                   for key, p in first.items()):
+                print(f"round {k}: transforms differ from the first round's")
+                differing += 1
+    print(f"wall fixed / auto over {len(ratios)} rounds: median {float(np.median(ratios)):.1f}x "
+          f"(range {min(ratios):.1f}-{max(ratios):.1f}x)")
+    return differing
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("fixed")
     parser.add_argument("auto")
     parser.add_argument("--truth")
     parser.add_argument("--pairs")
+    parser.add_argument("--round", nargs=2, action="append", default=[],
+                        metavar=("FIXED_OUT", "AUTO_OUT"))
     args = parser.parse_args(argv)
     fixed, fixed_run = load_run(args.fixed)
     auto, auto_run = load_run(args.auto)
@@ -98,8 +125,8 @@ def main(argv):
               f"{rung_counts(pairs)}")
     (fe, fw), (ae, aw) = totals["fixed"], totals["auto"]
     print(f"fixed / auto: evaluations {fe / max(ae, 1):.1f}x, wall {fw / aw:.1f}x")
+    bad = compare_rounds(args.round, fixed, auto, fw / aw) if args.round else 0
 
-    bad = 0
     worst = (0.0, 0.0)
     for key, f in fixed.items():
         a = auto.get(key)
