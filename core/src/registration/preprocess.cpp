@@ -99,43 +99,43 @@ Points VoxelDownsample(const Points& points, double voxel, CellOrder order) {
                      std::to_string((highest - lowest).maxCoeff()) + " m across");
   }
   const Point origin = lowest - Point::Constant(voxel) * 0.5;
+  struct Cell {
+    Eigen::Vector3i key;
+    Point sum = Point::Zero();
+    int count = 0;
+  };
   CellNumbers numbers;
-  std::vector<Eigen::Vector3i> keys;  // of the cells, in the order they were reached
-  Points sums;
-  std::vector<int> counts;
+  std::vector<Cell> cells;  // in the order the cloud first reaches them
   // Scans list neighbouring points one after another, so a point often
   // falls in the previous point's cell, which needs no lookup.
-  int32_t previous = -1;
+  Cell* previous = nullptr;
   for (const Point& p : points) {
     const Point scaled = (p - origin) / voxel;
     const Eigen::Vector3i key(static_cast<int>(std::floor(scaled.x())),
                               static_cast<int>(std::floor(scaled.y())),
                               static_cast<int>(std::floor(scaled.z())));
-    if (previous < 0 || key != keys[static_cast<size_t>(previous)]) {
-      previous = numbers.NumberOf(key);
-      if (static_cast<size_t>(previous) == keys.size()) {
-        keys.push_back(key);
-        sums.push_back(Point::Zero());
-        counts.push_back(0);
-      }
+    if (previous == nullptr || key != previous->key) {
+      const auto number = static_cast<size_t>(numbers.NumberOf(key));
+      if (number == cells.size()) cells.push_back({key});
+      previous = &cells[number];
     }
-    sums[static_cast<size_t>(previous)] += p;
-    ++counts[static_cast<size_t>(previous)];
+    previous->sum += p;
+    ++previous->count;
   }
-  std::vector<size_t> cells(keys.size());
-  std::iota(cells.begin(), cells.end(), size_t{0});
-  if (order == CellOrder::kOpen3d) {
-    // Open3D inserts each key into this map when the cloud first reaches
-    // its cell; the same insertions give the same iteration order.
-    std::unordered_map<Eigen::Vector3i, size_t, open3d::utility::hash_eigen<Eigen::Vector3i>> map;
-    for (size_t cell = 0; cell < keys.size(); ++cell) map.emplace(keys[cell], cell);
-    cells.clear();
-    for (const auto& [key, cell] : map) cells.push_back(cell);
-  }
+  const auto centroid = [](const Cell& cell) -> Point {
+    return cell.sum / static_cast<double>(cell.count);
+  };
   Points centroids;
   centroids.reserve(cells.size());
-  for (const size_t cell : cells)
-    centroids.push_back(sums[cell] / static_cast<double>(counts[cell]));
+  if (order == CellOrder::kFirstReached) {
+    for (const Cell& cell : cells) centroids.push_back(centroid(cell));
+    return centroids;
+  }
+  // Open3D inserts each key into this map when the cloud first reaches its
+  // cell; the same insertions give the same iteration order.
+  std::unordered_map<Eigen::Vector3i, size_t, open3d::utility::hash_eigen<Eigen::Vector3i>> map;
+  for (size_t number = 0; number < cells.size(); ++number) map.emplace(cells[number].key, number);
+  for (const auto& [key, number] : map) centroids.push_back(centroid(cells[number]));
   return centroids;
 }
 
