@@ -141,7 +141,7 @@ int RunMap(MapFlags flags) {
           "consecutive or explicit pairing");
     }
     if (sharded) CheckShardManifest(run, out);
-    CheckScansLoad(run.folder);
+    CheckScansLoad(run.folder, flags.threads);
     ChooseRunSettings(run);
     run.map.fusion_threads = flags.threads;
     std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());

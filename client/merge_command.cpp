@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "boicp/util/atomic_file.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "commands.hpp"
 #include "local_map.hpp"
 
@@ -45,7 +46,7 @@ int RunMerge(const MergeFlags& flags) {
     ChooseRunSettings(run);  // the shards' own choice: the same scans give the same settings
     const std::map<PairIndex, PairRecord> records =
         ReadStoredPairs(run, run.plan, flags.shard_dirs);
-    CheckScansLoad(run.folder);
+    CheckScansLoad(run.folder, AvailableCores());
     std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(),
                  run.folder.description.c_str(), records.size());
     PrintRunSettings(run);

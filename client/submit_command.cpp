@@ -7,6 +7,7 @@
 
 #include "boicp/rpc/proto_convert.hpp"
 #include "boicp/rpc/settings_proto.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "local_pipeline.hpp"
@@ -105,7 +106,7 @@ int RunSubmit(SubmitFlags& f) {
   Daemon daemon = ConnectToDaemon(f.remote);
   daemon.client->ListJobs(1);  // reachable and the token accepted, before the slow checks
   const auto check_start = Clock::now();
-  CheckScansLoad(folder);
+  CheckScansLoad(folder, AvailableCores());
   std::fprintf(stderr, "%s: %s; every scan loads (checked in %.1f s)\n", run.settings.path.c_str(),
                folder.description.c_str(),
                std::chrono::duration<double>(Clock::now() - check_start).count());

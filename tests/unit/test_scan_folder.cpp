@@ -24,6 +24,7 @@ using boicp::test::InputErrorMessage;
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 void WriteText(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());
@@ -340,12 +341,17 @@ TEST_F(ScanFolderTest, MissingOrUnrecognisableFolders) {
               HasSubstr("velodyne: no .bin scans"));
 }
 
-TEST_F(ScanFolderTest, CheckScansLoadNamesTheBadScan) {
-  const fs::path dir = MakeKitti(3, false);
-  EXPECT_NO_THROW(CheckScansLoad(ReadScanFolder(dir.string())));
+TEST_F(ScanFolderTest, CheckScansLoadNamesTheFirstBadScanWhateverTheThreads) {
+  const fs::path dir = MakeKitti(4, false);
+  EXPECT_NO_THROW(CheckScansLoad(ReadScanFolder(dir.string()), 2));
   WriteText(dir / "velodyne" / "000001.bin", "12345");  // not a multiple of 16 bytes
-  EXPECT_THAT(InputErrorMessage([&] { CheckScansLoad(ReadScanFolder(dir.string())); }),
-              HasSubstr("000001.bin"));
+  WriteText(dir / "velodyne" / "000003.bin", "123");
+  for (const int threads : {1, 4}) {
+    const std::string message =
+        InputErrorMessage([&] { CheckScansLoad(ReadScanFolder(dir.string()), threads); });
+    EXPECT_THAT(message, HasSubstr("000001.bin")) << threads << " threads";
+    EXPECT_THAT(message, Not(HasSubstr("000003.bin"))) << threads << " threads";
+  }
 }
 
 TEST(ScanFolderRealData, KittiAndSevenScenes) {
@@ -371,7 +377,7 @@ TEST(ScanFolderRealData, KittiAndSevenScenes) {
   ASSERT_EQ(scenes.scans.size(), 4u);
   EXPECT_EQ(fs::path(scenes.scans[3].path).filename().string(), "frame-000090.depth.png");
   EXPECT_TRUE(scenes.reference_poses[3].has_value());
-  EXPECT_NO_THROW(CheckScansLoad(scenes));
+  EXPECT_NO_THROW(CheckScansLoad(scenes, 2));
 }
 
 }  // namespace

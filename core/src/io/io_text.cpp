@@ -25,17 +25,19 @@ std::string Quoted(const std::string& line) {
 
 // Reads x y z from the first three fields (kFieldSeparators); later columns
 // (intensity, colour, labels) may hold anything and are ignored. Allocates
-// nothing unless the line is bad: a scan has hundreds of thousands of lines.
+// nothing unless the line is bad, and tests each character once: a scan has
+// hundreds of thousands of lines.
 Point ParseXyzLine(std::string_view line, const std::string& path, size_t line_number) {
   Point point;
-  size_t pos = line.find_first_not_of(kFieldSeparators);
+  const char* next = line.data();
+  const char* const end = next + line.size();
   for (Eigen::Index i = 0; i < 3; ++i) {
-    std::optional<double> value;
-    if (pos != std::string_view::npos) {
-      const size_t end = std::min(line.find_first_of(kFieldSeparators, pos), line.size());
-      value = ParseNumber(line.substr(pos, end - pos));
-      pos = line.find_first_not_of(kFieldSeparators, end);
-    }
+    while (next != end && IsFieldSeparator(*next)) ++next;
+    const char* const token = next;
+    while (next != end && !IsFieldSeparator(*next)) ++next;
+    const std::optional<double> value =
+        token == end ? std::nullopt
+                     : ParseNumber(std::string_view(token, static_cast<size_t>(next - token)));
     if (!value) {
       throw InputError(path + ":" + std::to_string(line_number) +
                        ": expected at least 3 numbers (x y z), got " + Quoted(std::string(line)));

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/util/parallel_for.hpp"
 #include "io/io_readers.hpp"
 
 namespace boicp {
@@ -451,9 +452,11 @@ ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& opti
   return folder;
 }
 
-void CheckScansLoad(const ScanFolder& folder) {
-  // LoadPointCloud's InputError already names the file and the problem.
-  for (const ScanSource& scan : folder.scans) LoadPointCloud(scan.path, scan.load);
+void CheckScansLoad(const ScanFolder& folder, int threads) {
+  // LoadPointCloud's InputError already names the file and the problem, and
+  // ParallelFor rethrows the first scan's in the folder's order.
+  ParallelFor(folder.scans.size(), threads,
+              [&](size_t k) { LoadPointCloud(folder.scans[k].path, folder.scans[k].load); });
 }
 
 }  // namespace boicp

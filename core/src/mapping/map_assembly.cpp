@@ -32,6 +32,9 @@ Points WithinRange(const Points& points, const Point& origin, double max_range) 
   return kept;
 }
 
+// Scans loaded and ray cast ahead of the tree update (FuseScans).
+constexpr int kFusionWindow = 4;
+
 // One scan ready to fuse: its ray-cast cells and, when the merged cloud is
 // wanted, its points within range (scan frame).
 struct PreparedScan {
@@ -40,12 +43,11 @@ struct PreparedScan {
 };
 
 PreparedScan PrepareScan(const OccupancyMap& map, const ScanSource& scan, const Transform& pose,
-                         const MapBuildSettings& settings, bool want_cloud,
+                         const MapBuildSettings& settings, bool want_cloud, int threads,
                          const MapStopRequest& stop) {
   PreparedScan prepared;
   Points points = LoadPointCloud(scan.path, scan.load).points;
-  prepared.update =
-      map.ComputeUpdate(points, pose, scan.sensor_origin, settings.fusion_threads, stop);
+  prepared.update = map.ComputeUpdate(points, pose, scan.sensor_origin, threads, stop);
   if (want_cloud) {
     prepared.cloud_points = WithinRange(points, scan.sensor_origin, settings.occupancy.max_range);
   }
@@ -111,35 +113,47 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   const bool want_cloud = !outputs.cloud_ply.empty();
   const int total = static_cast<int>(scans.size());
 
+  // A window of scans is applied to the tree, in scan order, while the next
+  // window is loaded and ray cast, each of its scans on its own threads.
+  // Whole scans are shared out rather than the rays of one scan, so a thread
+  // that has applied its window goes on to a scan instead of waiting for its
+  // part of one. The window is at most kFusionWindow scans: two windows of
+  // ray-cast cells are held at once. Only the timing depends on the thread
+  // count, never the tree. A stop request ends the ray casting, the tree
+  // update and the tree writes from inside, so a large scan or map does not
+  // hold a cancel or a drain back.
+  const int threads = std::max(settings.fusion_threads, 1);
+  const int window = std::min(threads, kFusionWindow);
+  const int ray_threads = std::max(threads / window, 1);
+  const auto window_at = [&](int first) { return std::max(std::min(window, total - first), 0); };
   const auto prepare = [&](int i) {
     const auto index = static_cast<size_t>(i);
-    return PrepareScan(map, scans[index], poses[index], settings, want_cloud,
+    return PrepareScan(map, scans[index], poses[index], settings, want_cloud, ray_threads,
                        callbacks.stop_requested);
   };
-  // A two-stage pipeline: scan i+1 is loaded and ray cast beside this
-  // thread while it applies scan i to the tree, in scan order. With one
-  // fusion thread the two stages run one after the other; either way only
-  // the timing differs, never the tree. A stop request ends the ray casting,
-  // the tree update and the tree writes from inside, so a large scan or map
-  // does not hold a cancel or a drain back.
-  const int stages = settings.fusion_threads > 1 ? 2 : 1;
-  PreparedScan current;
-  if (total > 0) {
+  std::vector<PreparedScan> current(static_cast<size_t>(window_at(0)));
+  ThrowIfStopped(callbacks);
+  ParallelFor(current.size(), threads,
+              [&](size_t k) { current[k] = prepare(static_cast<int>(k)); });
+  for (int first = 0; first < total; first += window) {
     ThrowIfStopped(callbacks);
-    current = prepare(0);
-  }
-  for (int i = 0; i < total; ++i) {
-    ThrowIfStopped(callbacks);
-    PreparedScan next;
-    ParallelFor(i + 1 < total ? 2 : 1, stages, [&](size_t stage) {
-      if (stage == 1) {
-        next = prepare(i + 1);
+    const int next_first = first + window;
+    std::vector<PreparedScan> next(static_cast<size_t>(window_at(next_first)));
+    ParallelFor(1 + next.size(), threads, [&](size_t task) {
+      if (task > 0) {
+        next[task - 1] = prepare(next_first + static_cast<int>(task) - 1);
         return;
       }
-      map.ApplyUpdate(current.update, callbacks.stop_requested);
-      if (want_cloud) cloud.Add(current.cloud_points, poses[static_cast<size_t>(i)]);
+      for (size_t k = 0; k < current.size(); ++k) {
+        map.ApplyUpdate(current[k].update, callbacks.stop_requested);
+        if (want_cloud) {
+          cloud.Add(current[k].cloud_points, poses[static_cast<size_t>(first) + k]);
+        }
+      }
     });
-    Report(callbacks, "fusing", i + 1, total);
+    for (size_t k = 1; k <= current.size(); ++k) {
+      Report(callbacks, "fusing", first + static_cast<int>(k), total);
+    }
     current = std::move(next);
   }
 

@@ -52,9 +52,10 @@ struct ScanFolder {
 /// side file (poses, calib, times) is malformed. Scans are not loaded here.
 ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& options = {});
 
-/// Loads every scan once and throws InputError naming the first one that
-/// does not load (unreadable, truncated, no finite point). Run before
-/// uploading or registering anything.
-void CheckScansLoad(const ScanFolder& folder);
+/// Loads every scan once, on at most `threads` threads, and throws
+/// InputError naming the first one in the folder's order that does not load
+/// (unreadable, truncated, no finite point). Run before uploading or
+/// registering anything.
+void CheckScansLoad(const ScanFolder& folder, int threads);
 
 }  // namespace boicp
