@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -21,6 +22,7 @@ struct MemoryBomb {
   std::string name;       // for messages
   std::string file_name;  // the extension tells the CLI the format
   uint64_t declared_points = 0;
+  std::string refusal;  // what refuses it, when not the 5 M-point limit
 };
 
 inline void AppendLittleEndianU32(std::string* out, uint32_t v) {
@@ -31,25 +33,59 @@ inline void AppendBigEndianU32(std::string* out, uint32_t v) {
   for (int i = 3; i >= 0; --i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xff));
 }
 
-/// binary_compressed PCD with 1-byte coordinates: 60 M points (1.4 GB of
-/// points once resized) in about 2 MB.
-inline void WritePcdBomb(const std::filesystem::path& path, uint64_t points) {
-  const uint64_t raw = 3 * points, compressed = raw / 88 + 1;
-  std::string text = "VERSION .7\nFIELDS x y z\nSIZE 1 1 1\nTYPE U U U\nCOUNT 1 1 1\nWIDTH " +
+/// LZF data that decodes to `size` zero bytes: a one-byte literal, then
+/// back-references to the byte before (3 bytes each for 264 bytes, LZF's
+/// best), and a literal for what remains. About 88 times smaller than decoded.
+inline std::string LzfZeros(uint64_t size) {
+  std::string lzf(2, '\0');  // literal run of one zero
+  uint64_t left = size - 1;
+  while (left >= 3) {
+    uint64_t length = std::min<uint64_t>(264, left);
+    if (left - length > 0 && left - length < 3) length = left - 3;
+    if (length - 2 < 7) {
+      lzf.push_back(static_cast<char>((length - 2) << 5));
+    } else {
+      lzf.push_back(static_cast<char>(0xE0));
+      lzf.push_back(static_cast<char>(length - 2 - 7));
+    }
+    lzf.push_back('\0');  // offset 0: the byte before
+    left -= length;
+  }
+  if (left > 0) {
+    lzf.push_back(static_cast<char>(left - 1));
+    lzf.append(left, '\0');
+  }
+  return lzf;
+}
+
+/// binary_compressed PCD of 1-byte coordinates and `padding` more bytes a
+/// point (a COUNT). Its data is real LZF, `expansion` times smaller than
+/// decoded; 88 is LZF's most (LzfZeros), less pads the data with zeros.
+inline void WritePcdBomb(const std::filesystem::path& path, uint64_t points, uint64_t padding,
+                         uint64_t expansion) {
+  const uint64_t raw = (3 + padding) * points;
+  std::string data = LzfZeros(raw);
+  if (data.size() < raw / expansion) data.resize(raw / expansion, '\0');
+  const bool padded = padding > 0;
+  std::string text = std::string("VERSION .7\nFIELDS x y z") + (padded ? " _" : "") +
+                     "\nSIZE 1 1 1" + (padded ? " 1" : "") + "\nTYPE U U U" + (padded ? " U" : "") +
+                     "\nCOUNT 1 1 1" + (padded ? " " + std::to_string(padding) : "") + "\nWIDTH " +
                      std::to_string(points) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " +
                      std::to_string(points) + "\nDATA binary_compressed\n";
-  AppendLittleEndianU32(&text, static_cast<uint32_t>(compressed));
+  AppendLittleEndianU32(&text, static_cast<uint32_t>(data.size()));
   AppendLittleEndianU32(&text, static_cast<uint32_t>(raw));
-  text.append(compressed, '\0');
+  text += data;
   std::ofstream(path, std::ios::binary) << text;
 }
 
-/// Binary PLY declaring one vertex per data byte (24 bytes of points each).
-inline void WritePlyBomb(const std::filesystem::path& path, uint64_t vertices) {
+/// Binary PLY declaring `vertices` of three 1-byte coordinates (Open3D
+/// allocates 72 bytes each) followed by `data_bytes` bytes.
+inline void WritePlyBomb(const std::filesystem::path& path, uint64_t vertices,
+                         uint64_t data_bytes) {
   std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex " +
                      std::to_string(vertices) +
                      "\nproperty uchar x\nproperty uchar y\nproperty uchar z\nend_header\n";
-  text.append(vertices, '\1');
+  text.append(data_bytes, '\1');
   std::ofstream(path, std::ios::binary) << text;
 }
 
@@ -117,19 +153,28 @@ inline void WriteXyzBomb(const std::filesystem::path& path, uint64_t points) {
   }
 }
 
-/// Every bomb, written into `dir`; each declares over 5 M points (the default limit).
+/// Every bomb, written into `dir`. Most declare over 5 M points (the default
+/// limit); two declare fewer and would still make Open3D allocate hundreds of
+/// megabytes: 420-byte padded PCD points compressed 88 times (420 MB from
+/// 5 MB), and PLY vertices one byte of data each (72 bytes each once read).
 inline std::vector<MemoryBomb> WriteMemoryBombs(const std::filesystem::path& dir) {
   constexpr uint32_t kPngSide = 8192;
-  WritePcdBomb(dir / "bomb.pcd", 60000000);
-  WritePlyBomb(dir / "bomb.ply", 40000000);
+  WritePcdBomb(dir / "bomb.pcd", 6000000, 0, 16);
+  WritePcdBomb(dir / "padded.pcd", 1000000, 417, 88);
+  WritePlyBomb(dir / "bomb.ply", 6000000, 18000000);
+  WritePlyBomb(dir / "short.ply", 4000000, 4000000);
   WriteDepthPngBomb(dir / "bomb.png", kPngSide);
   WriteKittiBomb(dir / "bomb.bin", 10000000);
   WriteXyzBomb(dir / "bomb.xyz", 10000000);
-  return {{"binary_compressed PCD", "bomb.pcd", 60000000},
-          {"PLY", "bomb.ply", 40000000},
-          {"depth PNG", "bomb.png", uint64_t{kPngSide} * kPngSide},
-          {"KITTI .bin", "bomb.bin", 10000000},
-          {"XYZ text", "bomb.xyz", 10000000}};
+  return {{"binary_compressed PCD", "bomb.pcd", 6000000, ""},
+          {"padded binary_compressed PCD", "padded.pcd", 1000000,
+           "binary points of 420 bytes; at most 64"},
+          {"PLY", "bomb.ply", 6000000, ""},
+          {"PLY short of its vertices", "short.ply", 4000000,
+           "4000000 vertices of at least 3 bytes declared"},
+          {"depth PNG", "bomb.png", uint64_t{kPngSide} * kPngSide, ""},
+          {"KITTI .bin", "bomb.bin", 10000000, ""},
+          {"XYZ text", "bomb.xyz", 10000000, ""}};
 }
 
 struct MeasuredRun {

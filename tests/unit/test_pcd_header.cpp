@@ -94,6 +94,25 @@ TEST_F(PcdHeaderTest, CompressedSizesBeyondTheFileAreRefusedBeforeAllocating) {
               HasSubstr("binary_compressed sizes"));
 }
 
+// Open3D decodes binary data whole, so padding declared with COUNT (417
+// bytes a point here) made a 24 MB file of 5 M points decode to 2 GB.
+TEST_F(PcdHeaderTest, BinaryPointsOfMoreThan64BytesAreRefused) {
+  std::string padded = Header("x y z _", "4 4 4 1", "F F F U", 2, "binary");
+  padded.replace(padded.find("COUNT 1 1 1"), 11, "COUNT 1 1 1 417");
+  EXPECT_THAT(LoadError(padded + std::string(2 * 429, '\0')),
+              HasSubstr("binary points of 429 bytes; at most 64"));
+  std::string pcl = Header("x y z _", "4 4 4 1", "F F F U", 2, "binary");
+  pcl.replace(pcl.find("COUNT 1 1 1"), 11, "COUNT 1 1 1 52");  // 64 bytes: still read
+  EXPECT_EQ(LoadPointCloud(Write(pcl + std::string(2 * 64, '\0'))).points.size(), 2u);
+}
+
+TEST_F(PcdHeaderTest, CompressedDataExpandingMoreThan16TimesIsRefused) {
+  const std::string header = Header("x y z", "4 4 4", "F F F", 1000, "binary_compressed");
+  EXPECT_THAT(
+      LoadError(header + LittleEndianU32(600) + LittleEndianU32(12000) + std::string(600, '\0')),
+      HasSubstr("would expand 20 times; at most 16"));
+}
+
 TEST_F(PcdHeaderTest, PointCountBeyondTheFileIsRefused) {
   EXPECT_THAT(LoadError(Header("x y z", "4 4 4", "F F F", 100000000, "binary") + "123456789012"),
               HasSubstr("truncated PCD"));

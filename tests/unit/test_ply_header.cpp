@@ -41,7 +41,29 @@ std::string LoadError(const std::string& bytes, size_t* points = nullptr) {
 TEST(PlyHeaderTest, VertexCountBeyondTheFileIsRefused) {
   EXPECT_THAT(LoadError(std::string("ply\nformat ascii 1.0\nelement vertex 2000000000\n") +
                         kVertexProperties + "end_header\n1 2 3\n"),
-              HasSubstr("truncated PLY (2000000000 vertices declared, 6 data bytes)"));
+              HasSubstr("truncated PLY (2000000000 vertices of at least 6 bytes declared, 6 "
+                        "data bytes)"));
+}
+
+// Open3D sizes points, normals and colours (72 bytes) by the vertex count, so
+// each vertex must take its properties' bytes in the file: a binary vertex of
+// three floats 12, an ascii one 6.
+TEST(PlyHeaderTest, VerticesMustFillTheirPropertiesBytes) {
+  const std::string binary = std::string("ply\nformat binary_little_endian 1.0\nelement vertex ");
+  const std::string floats = std::string(kVertexProperties) + "end_header\n";
+  EXPECT_THAT(LoadError(binary + "1000\n" + floats + std::string(11999, '\0')),
+              HasSubstr("1000 vertices of at least 12 bytes declared, 11999 data bytes"));
+  size_t points = 0;
+  EXPECT_EQ(LoadError(binary + "1000\n" + floats + std::string(12000, '\0'), &points), "");
+  EXPECT_EQ(points, 1000u);
+  // A face list counts its count byte only; doubles count 8.
+  EXPECT_THAT(
+      LoadError(binary + "10\nproperty double x\nproperty double y\nproperty double z\n" +
+                "property list uchar int vertex_indices\nend_header\n" + std::string(249, '\0')),
+      HasSubstr("10 vertices of at least 25 bytes declared, 249 data bytes"));
+  EXPECT_THAT(LoadError(std::string("ply\nformat ascii 1.0\nelement vertex 3\n") + floats +
+                        "1 2 3\n4 5 6\n"),
+              HasSubstr("3 vertices of at least 6 bytes declared, 12 data bytes"));
 }
 
 TEST(PlyHeaderTest, ElementSplitAcrossLinesIsRefused) {

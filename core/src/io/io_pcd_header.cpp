@@ -25,8 +25,15 @@ namespace {
 // would be split differently by the two parsers.
 constexpr size_t kMaxHeaderLine = 1000;
 constexpr size_t kMaxHeaderLines = 64;
-// An LZF back-reference copies at most 264 bytes from 3 input bytes.
-constexpr uint64_t kLzfMaxExpansion = 88;
+// Open3D decodes binary data whole before it keeps x/y/z, so its memory is
+// POINTS x the point's size. Scans carry a few fields (x, y, z, intensity,
+// ring, time, PCL's padding: 16-48 bytes); 64 bounds a 5 M-point scan's
+// decoding to 320 MB, where COUNT padding could otherwise ask for 2 GB.
+constexpr uint64_t kMaxBinaryPointBytes = 64;
+// Point data compresses a few times at most (coordinates hardly at all); an
+// LZF back-reference could copy 264 bytes from 3, so a file of zeros would
+// otherwise decode to 88 times its size.
+constexpr uint64_t kMaxCompressedExpansion = 16;
 // Open3D indexes the data with int arithmetic.
 constexpr uint64_t kMaxDataBytes = static_cast<uint64_t>(std::numeric_limits<int>::max());
 
@@ -224,6 +231,11 @@ void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t 
     RequireAsciiPointLines(path, header, data_offset);
     return;
   }
+  if (header.point_bytes > kMaxBinaryPointBytes) {
+    Fail(path, "binary points of " + std::to_string(header.point_bytes) + " bytes; at most " +
+                   std::to_string(kMaxBinaryPointBytes) +
+                   " are read (keep x, y, z and a few fields, or write ascii)");
+  }
   if (header.data == "binary") {
     if (declared > available) {
       throw InputError(path + ": truncated PCD (" + std::to_string(declared) +
@@ -243,8 +255,13 @@ void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t 
     throw InputError(path + ": truncated PCD (" + std::to_string(compressed) +
                      " compressed bytes declared, " + std::to_string(available - 8) + " present)");
   }
-  if (uncompressed != declared || uncompressed > kLzfMaxExpansion * compressed) {
+  if (uncompressed != declared) {
     Fail(path, "binary_compressed sizes do not match POINTS and the fields");
+  }
+  if (uncompressed > kMaxCompressedExpansion * compressed) {
+    Fail(path, "binary_compressed data would expand " +
+                   std::to_string(uncompressed / std::max<uint64_t>(compressed, 1)) +
+                   " times; at most " + std::to_string(kMaxCompressedExpansion) + " is accepted");
   }
 }
 

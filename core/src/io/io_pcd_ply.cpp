@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <optional>
-#include <set>
 #include <string_view>
 
 #include <open3d/geometry/PointCloud.h>
@@ -35,12 +35,17 @@ std::vector<std::string_view> PlyWords(std::string_view line) {
   return words;
 }
 
-bool IsPlyScalarType(std::string_view word) {
-  static const std::set<std::string_view> kTypes = {
-      "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
-      "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
-  return kTypes.count(word) != 0;
+// Bytes of a PLY scalar type; 0 for a word that is none.
+uint64_t PlyScalarBytes(std::string_view word) {
+  static const std::map<std::string_view, uint64_t> kBytes = {
+      {"char", 1},   {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
+      {"int16", 2},  {"uint16", 2},  {"int", 4},    {"uint", 4},   {"float", 4}, {"int32", 4},
+      {"uint32", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
+  const auto it = kBytes.find(word);
+  return it == kBytes.end() ? 0 : it->second;
 }
+
+bool IsPlyScalarType(std::string_view word) { return PlyScalarBytes(word) != 0; }
 
 bool IsPlyFormatLine(const std::vector<std::string_view>& w) {
   return w.size() == 3 && w[0] == "format" && w[2] == "1.0" &&
@@ -71,7 +76,10 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
   if (!line.empty() && line.back() == '\r') line.pop_back();
   if (line != "ply") fail("first line is not 'ply'");
   std::optional<uint64_t> vertices;
+  bool ascii = false;
   bool in_element = false;
+  bool in_vertex = false;
+  uint64_t vertex_bytes = 0;  // the least one vertex takes
   for (size_t n = 2; n <= kMaxHeaderLines && std::getline(in, line); ++n) {
     const std::string where = "line " + std::to_string(n);
     if (line.size() > kMaxHeaderLine) fail(where + " too long");
@@ -82,20 +90,25 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
     }
     const std::vector<std::string_view> words = PlyWords(line);
     if (n == 2 && !IsPlyFormatLine(words)) fail("line 2 is not 'format <ascii|binary_*> 1.0'");
+    if (n == 2) ascii = words[1] == "ascii";
     if (n == 2 || words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
     if (words[0] == "end_header" && words.size() == 1) {
       std::error_code ec;
       const uint64_t size = std::filesystem::file_size(path, ec);
       if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
       const uint64_t data = in.eof() ? 0 : size - static_cast<uint64_t>(in.tellg());
-      if (vertices && *vertices > data) {
+      if (vertices && *vertices > data / std::max<uint64_t>(vertex_bytes, 1)) {
         throw InputError(path + ": truncated PLY (" + std::to_string(*vertices) +
-                         " vertices declared, " + std::to_string(data) + " data bytes)");
+                         " vertices of at least " + std::to_string(vertex_bytes) +
+                         " bytes declared, " + std::to_string(data) + " data bytes)");
       }
       if (vertices) RequirePointCount(path, *vertices, max_points);
       return;
     }
-    if (words[0] == "property" && in_element && IsPlyPropertyLine(words)) continue;
+    if (words[0] == "property" && in_element && IsPlyPropertyLine(words)) {
+      if (in_vertex) vertex_bytes += ascii ? 2 : PlyScalarBytes(words[words.size() == 3 ? 1 : 2]);
+      continue;
+    }
     const std::optional<double> count =
         words.size() == 3 && words[0] == "element" ? ParseNumber(words[2]) : std::nullopt;
     if (!count || !(*count >= 0.0 && *count < 1e15) ||
@@ -103,7 +116,8 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
       fail(where + " is not a format, comment, element, property or end_header line");
     }
     in_element = true;
-    if (words[1] != "vertex") continue;
+    in_vertex = words[1] == "vertex";
+    if (!in_vertex) continue;
     if (vertices) fail("two vertex elements");
     vertices = static_cast<uint64_t>(*count);
   }
