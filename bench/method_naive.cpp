@@ -24,7 +24,8 @@ MethodOutput RunNaiveBoIcp(const MethodInput& input) {
   BoIcpConfig config = DatasetBoConfig("C", input);
   // The ICP below reads the config's gate, so automatic settings are chosen first.
   ApplyChosenSettings(
-      ChooseSettingsForClouds({&input.source, &input.target}, CloudFormat::kAuto, config.seed),
+      ChooseSettingsForClouds({&input.source, &input.target},
+                              DeclareSensor(config.sensor, CloudFormat::kAuto), config.seed),
       config);
   config.retry_when_doubtful = false;                  // the paper's method searches once
   config.icp_objective = IcpObjective::kPointToPoint;  // what local_icp below runs

@@ -84,9 +84,14 @@ int RunExport(const ExportFlags& f) {
     throw std::runtime_error("job " + f.job_id + " is " + rpc::JobStateName(job.state()) +
                              "; only a succeeded job can be exported");
   }
-  // Without --sensor-up, the job's scan format says where its sensors' up is.
-  if (!up_options.sensor_up && job.settings().scan_format() != v1::SCAN_FORMAT_UNSPECIFIED)
-    up_options.sensor_up = SensorUp(rpc::FormatFromProto(job.settings().scan_format()));
+  // Without --sensor-up, the job's sensor setting, else its scan format, says
+  // where its sensors' up is.
+  if (!up_options.sensor_up) {
+    const int format = job.settings().scan_format();
+    up_options.sensor_up = SensorUp(
+        ParseSensorSetting(job.settings().config().sensor()),
+        format == v1::SCAN_FORMAT_UNSPECIFIED ? CloudFormat::kAuto : rpc::FormatFromProto(format));
+  }
   const fs::path parent = fs::path(output).parent_path();
   if (!parent.empty()) fs::create_directories(parent);
   uint64_t bytes = 0;

@@ -57,7 +57,8 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
                                         const std::string& out_dir) {
   const fs::path dir(out_dir);
   UpDetectionOptions up_options;
-  if (!run.folder.scans.empty()) up_options.sensor_up = SensorUp(run.folder.scans[0].load.format);
+  if (!run.folder.scans.empty())
+    up_options.sensor_up = SensorUp(run.config.sensor, run.folder.scans[0].load.format);
   const UpDirection up = WriteMapPreview(LocalOutputPaths(out_dir).octomap_bt, map.estimate.poses,
                                          (dir / "preview.png").string(), {}, up_options);
   std::fprintf(stderr, "preview: %s\n", up.reason.c_str());

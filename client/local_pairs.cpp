@@ -53,6 +53,9 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
   // Pairs registered before the budget existed ran the paper's full search,
   // which the fixed budget still runs; an auto run registers them again.
   if (!config.contains("budget")) config["budget"] = BudgetName(Budget::kFixed);
+  // Before the sensor could be set, the format and the geometry chose it, as
+  // "auto" still does.
+  if (!config.contains("sensor")) config["sensor"] = SensorSettingName(std::nullopt);
   if (!config.contains("retry_when_doubtful")) return;
   static const std::pair<const char*, const char*> kRenamed[] = {
       {"max_correspondence_distance", "max_correspondence"},

@@ -136,7 +136,7 @@ LocalRun PrepareRun(const MapSettings& settings) {
     }
   } else if (settings.pairing == "overlap") {
     run.keyframes = true;
-    run.overlap_threshold = BatchOverlapThreshold(run.folder.scans);
+    run.overlap_threshold = BatchOverlapThreshold(run.folder.scans, run.config.sensor);
   } else {
     throw InputError("--pairing: '" + settings.pairing +
                      "' is not consecutive, overlap or explicit");

@@ -102,7 +102,8 @@ int RunRegister(const RegisterFlags& flags) {
     std::optional<Transform> prior;
     if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
     const ChosenSettings chosen = ChooseSettingsForClouds(
-        {&source.points, &target.points}, source.format, config.seed, 2, config.threads);
+        {&source.points, &target.points}, DeclareSensor(config.sensor, source.format), config.seed,
+        2, config.threads);
     const std::vector<std::string> auto_fields = ApplyChosenSettings(chosen, config);
     ValidateConfig(config);
     if (!flags.quiet) {

@@ -88,7 +88,10 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
       if (threshold != 0.0 && !(threshold > 0.0 && threshold <= 1.0)) {
         throw InputError("pairing.overlap_threshold must be in (0, 1] (0 = default)");
       }
-      spec.overlap_threshold = threshold != 0.0 ? threshold : BatchOverlapThreshold(spec.scans);
+      spec.overlap_threshold =
+          threshold != 0.0
+              ? threshold
+              : BatchOverlapThreshold(spec.scans, ParseSensorSetting(request.config().sensor()));
       spec.extra_pairs = listed;
       ValidatePairs(n, listed, /*require_connected=*/false);
       break;

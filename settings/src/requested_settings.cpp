@@ -27,6 +27,7 @@ BoIcpConfig ConfigFromSettings(const RequestedSettings& settings) {
   config.mode = ParseSearchMode(settings.mode);
   config.icp_objective = ParseIcpObjective(settings.icp_objective);
   config.budget = ParseBudget(settings.budget);
+  config.sensor = ParseSensorSetting(settings.sensor);
   config.retry_when_doubtful = !settings.no_retry;
   config.seed = settings.seed;
   for (const SettingField& field : SettingSchema()) {
@@ -51,6 +52,7 @@ RequestedSettings SettingsFromConfig(const BoIcpConfig& config) {
   settings.mode = SearchModeName(config.mode);
   settings.icp_objective = IcpObjectiveName(config.icp_objective);
   settings.budget = BudgetName(config.budget);
+  settings.sensor = SensorSettingName(config.sensor);
   settings.seed = config.seed;
   settings.no_retry = !config.retry_when_doubtful;
   for (const SettingField& field : SettingSchema()) {

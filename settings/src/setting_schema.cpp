@@ -51,6 +51,12 @@ std::vector<SettingField> BuildSchema() {
        "auto (cheapest first: prior, features, short search, full search, retry, each only "
        "while the answer is doubtful) or fixed (the paper's full search, then the retry)",
        nullptr, PlainBinding<std::string>{&RS::budget}, kUnbounded},
+      // run.json's "sensor" is the sensor found and why.
+      {"sensor", "--sensor", nullptr, "sensor_setting", kReg, "sensor", kEveryFrontEnd,
+       "lidar, depth or object: the sensor the scans come from, which sets the rotation box, "
+       "the map's up and the keyframe overlap; default auto: from the file format, else from "
+       "the scans' geometry",
+       nullptr, PlainBinding<std::string>{&RS::sensor}, kUnbounded},
       {"seed", "--seed", nullptr, "seed", kReg, "seed", kEveryFrontEnd,
        "Seed of every random choice; each pair's seed derives from it", nullptr,
        PlainBinding<uint64_t>{&RS::seed}, kUnbounded},

@@ -363,6 +363,7 @@ TEST_F(MapCli, FarReturnsAreListedInRunJson) {
     EXPECT_EQ(entry["points"], i == 1 ? added : 0u) << "scan " << i;
   }
   // The sensor the settings assumed, and why: the far returns do not hide the ring.
+  EXPECT_EQ(manifest["sensor_setting"], "auto");  // --sensor, not given
   EXPECT_EQ(manifest["sensor"]["type"], "lidar");
   EXPECT_THAT(manifest["sensor"]["why"].get<std::string>(), HasSubstr("ring covering 360 deg"));
   EXPECT_THAT(r.err, HasSubstr("settings: sensor lidar (ring covering 360 deg"));

@@ -58,6 +58,27 @@ void ExpectAttemptsAddUp(const nlohmann::json& j) {
   EXPECT_EQ(evaluations, j["evaluations"]);
 }
 
+// --sensor replaces what the geometry says: the street's ring taken as an
+// object's scan gets every rotation, and the JSON says who decided.
+TEST_F(Cli, RegisterSensorSettingDecidesTheSensorAndSaysSo) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const std::string args = "register --source " + (dir_ / "source.xyz").string() + " --target " +
+                           (dir_ / "target.xyz").string() + " --config A --seed 3 --json";
+  const RunResult r = Run(args + " --sensor object");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["sensor"]["type"], "other");
+  EXPECT_EQ(j["sensor"]["why"], "set by --sensor");
+  EXPECT_EQ(j["config"]["sensor"], "object");
+  EXPECT_EQ(j["config"]["rotation_bounds"], nlohmann::json({M_PI, M_PI / 2, M_PI}));
+
+  const RunResult bad = Run(args + " --sensor camera");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(
+      bad.err,
+      HasSubstr("--sensor: unknown sensor 'camera' (expected lidar, depth, object or auto)"));
+}
+
 TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
   const std::string args = "register --source " + (dir_ / "source.xyz").string() + " --target " +
@@ -80,6 +101,7 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   }
   EXPECT_EQ(j["config"]["preset"], "A");
   EXPECT_EQ(j["config"]["budget"], "auto");
+  EXPECT_EQ(j["config"]["sensor"], "auto");
   // The rotation box was given ("pi" is pi); the rest came from the clouds.
   EXPECT_EQ(j["config"]["rotation_bounds"][2].get<double>(), M_PI);
   EXPECT_EQ(j["auto"], nlohmann::json({"voxel", "refine_voxel", "objective_truncation",

@@ -58,8 +58,8 @@ TEST_P(FarReturns, AreSetAsideBeforeChoosingSettings) {
     EXPECT_LE(far_stats.far_returns, added);
     EXPECT_GE(static_cast<double>(far_stats.far_returns), 0.99 * static_cast<double>(added));
 
-    const ChosenSettings a = ChooseSettings({clean_stats}, CloudFormat::kAuto);
-    const ChosenSettings b = ChooseSettings({far_stats}, CloudFormat::kAuto);
+    const ChosenSettings a = ChooseSettings({clean_stats}, std::nullopt);
+    const ChosenSettings b = ChooseSettings({far_stats}, std::nullopt);
     EXPECT_EQ(a.sensor, b.sensor);
     ExpectClose(b.voxel, a.voxel, 0.03, "voxel");
     for (int axis = 0; axis < 3; ++axis) {

@@ -3,7 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "boicp/mapping/batch_pair.hpp"
 #include "boicp/mapping/map_pairs.hpp"
+#include "boicp/mapping/map_up.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -48,8 +50,26 @@ TEST(MapPairs, PairSeedDependsOnJobSeedAndPairOnly) {
 }
 
 TEST(MapPairs, DefaultOverlapThresholdsAreThePapers) {
-  EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(CloudFormat::kKittiBin), 0.7);
-  EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(CloudFormat::kDepthPng), 0.6);
+  EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(SensorKind::kLidar), 0.7);
+  EXPECT_DOUBLE_EQ(DefaultOverlapThreshold(SensorKind::kDepthCamera), 0.6);
+}
+
+// The format stands in for the sensor only until --sensor sets it.
+TEST(MapPairs, ASetSensorDecidesTheOverlapAndTheUpInsteadOfTheFormat) {
+  std::vector<ScanSource> depth_images(2), point_files(2);
+  for (ScanSource& scan : depth_images) scan.load.format = CloudFormat::kDepthPng;
+  for (ScanSource& scan : point_files) scan.load.format = CloudFormat::kPcd;
+  EXPECT_DOUBLE_EQ(BatchOverlapThreshold(depth_images, std::nullopt), 0.6);
+  EXPECT_DOUBLE_EQ(BatchOverlapThreshold(point_files, std::nullopt), 0.7);
+  EXPECT_DOUBLE_EQ(BatchOverlapThreshold(point_files, SensorKind::kDepthCamera), 0.6);
+  EXPECT_DOUBLE_EQ(BatchOverlapThreshold(depth_images, SensorKind::kLidar), 0.7);
+
+  EXPECT_EQ(SensorUp(std::nullopt, CloudFormat::kPcd), std::nullopt);
+  EXPECT_EQ(SensorUp(std::nullopt, CloudFormat::kKittiBin), Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(SensorUp(std::nullopt, CloudFormat::kDepthPng), Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(SensorUp(SensorKind::kLidar, CloudFormat::kPcd), Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(SensorUp(SensorKind::kDepthCamera, CloudFormat::kPcd), Eigen::Vector3d(0, -1, 0));
+  EXPECT_EQ(SensorUp(SensorKind::kOther, CloudFormat::kKittiBin), std::nullopt);
 }
 
 using ProbeOutcome = KeyframePlanner::ProbeOutcome;

@@ -46,6 +46,7 @@ TEST(SettingSchema, EveryRegisterFlagReachesTheConfigAndSurvivesJson) {
   EXPECT_EQ(config.preset, "B");
   EXPECT_EQ(config.mode, SearchMode::kSixDof);
   EXPECT_EQ(config.budget, Budget::kFixed);
+  EXPECT_EQ(config.sensor, SensorKind::kDepthCamera);
   EXPECT_FALSE(config.retry_when_doubtful);
   EXPECT_TRUE(config.automatic.empty());
   for (const SettingField& field : SettingSchema()) {
@@ -97,6 +98,7 @@ TEST(SettingSchema, ConfigAsUsedNamesEveryRegistrationSettingAndReadsBack) {
   EXPECT_EQ(used["preset"], "B");
   EXPECT_EQ(used["no_retry"], true);
   EXPECT_EQ(used["budget"], "fixed");
+  EXPECT_EQ(used["sensor"], "depth");
   EXPECT_EQ(used["rotation_bounds"], nlohmann::json({0.25, 0.5, 1.25}));
 
   const BoIcpConfig read_back = ConfigFromJson(used, "test");
@@ -201,6 +203,7 @@ TEST(SettingSchema, BudgetIsAutoUnlessFixedOnEveryFrontEnd) {
 TEST(SettingSchema, AnUnknownWordNamesItsFlagAndTheWordsAllowed) {
   const std::pair<const char*, const char*> cases[] = {
       {"--budget", "--budget: unknown budget 'nope' (expected auto or fixed)"},
+      {"--sensor", "--sensor: unknown sensor 'nope' (expected lidar, depth, object or auto)"},
       {"--mode", "--mode: unknown search mode 'nope' (expected nested or 6dof)"},
       {"--icp-objective",
        "--icp-objective: unknown ICP objective 'nope' (expected point or plane)"},

@@ -51,7 +51,8 @@ BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoI
   std::vector<const Points*> pointers;
   for (const Points& cloud : clouds) pointers.push_back(&cloud);
   // Every loaded cloud is measured, in order (max_clouds = their number).
-  const ChosenSettings chosen = ChooseSettingsForClouds(pointers, format, config.seed, count);
+  const ChosenSettings chosen =
+      ChooseSettingsForClouds(pointers, DeclareSensor(config.sensor, format), config.seed, count);
   for (size_t k = 0; k < count; ++k) choice.measured[k].far_returns = chosen.far_returns[k];
   choice.sensor = chosen.sensor;
   choice.sensor_reason = chosen.sensor_reason;
@@ -67,12 +68,13 @@ BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoI
   return choice;
 }
 
-double BatchOverlapThreshold(const std::vector<ScanSource>& scans) {
-  for (const ScanSource& scan : scans) {
-    if (scan.load.format != CloudFormat::kDepthPng)
-      return DefaultOverlapThreshold(scan.load.format);
-  }
-  return DefaultOverlapThreshold(CloudFormat::kDepthPng);
+double BatchOverlapThreshold(const std::vector<ScanSource>& scans,
+                             const std::optional<SensorKind>& sensor) {
+  if (sensor) return DefaultOverlapThreshold(*sensor);
+  const bool depth_images = std::all_of(scans.begin(), scans.end(), [](const ScanSource& scan) {
+    return scan.load.format == CloudFormat::kDepthPng;
+  });
+  return DefaultOverlapThreshold(depth_images ? SensorKind::kDepthCamera : SensorKind::kOther);
 }
 
 std::string DoubtfulSummary(int doubtful, int total) {

@@ -86,8 +86,8 @@ uint64_t PairSeed(uint64_t job_seed, const PairIndex& pair) {
   return SplitMix64(SplitMix64(job_seed) ^ packed);
 }
 
-double DefaultOverlapThreshold(CloudFormat format) {
-  return format == CloudFormat::kDepthPng ? 0.6 : 0.7;
+double DefaultOverlapThreshold(SensorKind sensor) {
+  return sensor == SensorKind::kDepthCamera ? 0.6 : 0.7;
 }
 
 KeyframePlanner::KeyframePlanner(int num_scans, double overlap_threshold)

@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/surface_normals.hpp"
 
 namespace boicp {
@@ -70,10 +71,11 @@ Eigen::Vector3d RefineAxis(const Eigen::Vector3d& axis, const std::vector<Eigen:
 
 }  // namespace
 
-std::optional<Eigen::Vector3d> SensorUp(CloudFormat format) {
-  if (format == CloudFormat::kDepthPng) return Eigen::Vector3d(0, -1, 0);
-  if (format == CloudFormat::kKittiBin) return Eigen::Vector3d::UnitZ();
-  return std::nullopt;
+std::optional<Eigen::Vector3d> SensorUp(const std::optional<SensorKind>& set, CloudFormat format) {
+  const std::optional<DeclaredSensor> declared = DeclareSensor(set, format);
+  if (!declared || declared->kind == SensorKind::kOther) return std::nullopt;
+  if (declared->kind == SensorKind::kDepthCamera) return Eigen::Vector3d(0, -1, 0);
+  return Eigen::Vector3d::UnitZ();
 }
 
 UpDirection DetectUp(const Points& centres, const std::vector<double>& sizes, double resolution,

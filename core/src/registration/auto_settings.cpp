@@ -158,20 +158,19 @@ std::string FactorText(double factor) {
 }
 
 // Why ChooseSettings took the sensor it took, in the words of its rules:
-// the format when that decides, else the least all-around of the clouds;
-// then, for a LiDAR, the ground its rotation box relies on.
-std::string SensorReason(const std::vector<CloudStatistics>& stats, CloudFormat format,
-                         SensorKind sensor, bool level) {
+// what was declared, else the least all-around of the clouds; then, for a
+// LiDAR, the ground its rotation box relies on.
+std::string SensorReason(const std::vector<CloudStatistics>& stats,
+                         const std::optional<DeclaredSensor>& declared, SensorKind sensor,
+                         bool level) {
   const auto least_around = std::min_element(
       stats.begin(), stats.end(), [](const CloudStatistics& a, const CloudStatistics& b) {
         return std::make_pair(a.all_around, -a.mean_direction) <
                std::make_pair(b.all_around, -b.mean_direction);
       });
   char text[160];
-  if (format == CloudFormat::kKittiBin) {
-    std::snprintf(text, sizeof text, "KITTI .bin scans (a spinning LiDAR)");
-  } else if (format == CloudFormat::kDepthPng) {
-    std::snprintf(text, sizeof text, "depth images");
+  if (declared) {
+    std::snprintf(text, sizeof text, "%s", declared->why.c_str());
   } else if (least_around->mean_direction > kMaxAllAroundDirection) {
     std::snprintf(text, sizeof text, "one-sided view (mean direction %.2f)",
                   least_around->mean_direction);
@@ -257,18 +256,6 @@ double RefineVoxel(double voxel, double spacing) {
 
 }  // namespace
 
-std::string SensorKindName(SensorKind kind) {
-  switch (kind) {
-    case SensorKind::kLidar:
-      return "lidar";
-    case SensorKind::kDepthCamera:
-      return "depth camera";
-    case SensorKind::kOther:
-      break;
-  }
-  return "other";
-}
-
 CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
   const std::string advice =
       " to choose settings from; give --voxel and --translation-bounds (or --fixed-settings)";
@@ -310,7 +297,19 @@ CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
   return stats;
 }
 
-ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format) {
+std::optional<DeclaredSensor> DeclareSensor(const std::optional<SensorKind>& set,
+                                            CloudFormat format) {
+  if (set) return DeclaredSensor{*set, "set by --sensor"};
+  if (format == CloudFormat::kKittiBin) {
+    return DeclaredSensor{SensorKind::kLidar, "KITTI .bin scans (a spinning LiDAR)"};
+  }
+  if (format == CloudFormat::kDepthPng)
+    return DeclaredSensor{SensorKind::kDepthCamera, "depth images"};
+  return std::nullopt;
+}
+
+ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats,
+                              const std::optional<DeclaredSensor>& declared) {
   if (stats.empty()) throw InputError("automatic settings need at least one cloud");
   CheckSharedUnits(stats);
   std::vector<double> radii, ranges, spacings, tilts;
@@ -325,12 +324,12 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFo
   }
   ChosenSettings chosen;
   for (const CloudStatistics& s : stats) chosen.far_returns.push_back(s.far_returns);
-  if (format == CloudFormat::kKittiBin || (format != CloudFormat::kDepthPng && all_around)) {
+  if (declared) {
+    chosen.sensor = declared->kind;
+  } else if (all_around) {
     chosen.sensor = SensorKind::kLidar;
-  } else if (format == CloudFormat::kDepthPng) {
-    chosen.sensor = SensorKind::kDepthCamera;
   }
-  chosen.sensor_reason = SensorReason(stats, format, chosen.sensor, level);
+  chosen.sensor_reason = SensorReason(stats, declared, chosen.sensor, level);
   chosen.voxel = Median(radii) / kRadiusPerVoxel;
   chosen.point_spacing = Median(spacings);
   const double radius = Median(radii);
@@ -356,8 +355,9 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFo
   return chosen;
 }
 
-ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds, CloudFormat format,
-                                       uint64_t seed, size_t max_clouds, int threads) {
+ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
+                                       const std::optional<DeclaredSensor>& declared, uint64_t seed,
+                                       size_t max_clouds, int threads) {
   if (clouds.empty()) throw InputError("automatic settings need at least one cloud");
   const size_t count = std::min(std::max<size_t>(max_clouds, 1), clouds.size());
   std::vector<CloudStatistics> stats(count);
@@ -365,7 +365,7 @@ ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
     const size_t index = count == 1 ? 0 : k * (clouds.size() - 1) / (count - 1);
     stats[k] = MeasureCloud(*clouds[index], seed + index);
   });
-  return ChooseSettings(stats, format);
+  return ChooseSettings(stats, declared);
 }
 
 std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcpConfig& config) {

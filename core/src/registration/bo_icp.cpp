@@ -398,10 +398,11 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
   BoIcpConfig config = requested;
   std::vector<std::string> auto_fields;
   if (!config.automatic.empty()) {
-    auto_fields =
-        ApplyChosenSettings(ChooseSettingsForClouds({&source, &target}, CloudFormat::kAuto,
-                                                    config.seed, 2, config.threads),
-                            config);
+    auto_fields = ApplyChosenSettings(
+        ChooseSettingsForClouds({&source, &target},
+                                DeclareSensor(config.sensor, CloudFormat::kAuto), config.seed, 2,
+                                config.threads),
+        config);
   }
   ValidateConfig(config);
   RegistrationResult result =

@@ -36,6 +36,39 @@ Budget ParseBudget(const std::string& name) {
 
 std::string BudgetName(Budget budget) { return budget == Budget::kAuto ? "auto" : "fixed"; }
 
+std::string SensorKindName(SensorKind kind) {
+  switch (kind) {
+    case SensorKind::kLidar:
+      return "lidar";
+    case SensorKind::kDepthCamera:
+      return "depth camera";
+    case SensorKind::kOther:
+      break;
+  }
+  return "other";
+}
+
+std::optional<SensorKind> ParseSensorSetting(const std::string& name) {
+  if (name == "auto" || name.empty()) return std::nullopt;
+  if (name == "lidar") return SensorKind::kLidar;
+  if (name == "depth") return SensorKind::kDepthCamera;
+  if (name == "object") return SensorKind::kOther;
+  throw InputError("unknown sensor '" + name + "' (expected lidar, depth, object or auto)");
+}
+
+std::string SensorSettingName(const std::optional<SensorKind>& sensor) {
+  if (!sensor) return "auto";
+  switch (*sensor) {
+    case SensorKind::kLidar:
+      return "lidar";
+    case SensorKind::kDepthCamera:
+      return "depth";
+    case SensorKind::kOther:
+      break;
+  }
+  return "object";
+}
+
 const std::vector<std::string> kAutoRegistrationFields = {
     "voxel", "refine_voxel", "objective_truncation", "translation_bounds", "rotation_bounds"};
 

@@ -64,9 +64,10 @@ struct BatchSettingsChoice {
 BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoIcpConfig& config,
                                        OccupancySettings& occupancy, const MapAutoFields& map_auto);
 
-/// The keyframe overlap threshold of a batch: that of its first non-depth
-/// scan's format (0.7), or 0.6 when every scan is a depth image.
-double BatchOverlapThreshold(const std::vector<ScanSource>& scans);
+/// The keyframe overlap threshold of a batch: that of the `sensor` the user
+/// set, else 0.6 when every scan is a depth image and 0.7 otherwise.
+double BatchOverlapThreshold(const std::vector<ScanSource>& scans,
+                             const std::optional<SensorKind>& sensor);
 
 /// The closing line of a batch: "2 of 40 pairs doubtful" (doubtful =
 /// confidence below kDoubtfulBelow).

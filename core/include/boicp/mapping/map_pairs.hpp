@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/registration/config.hpp"
 
 namespace boicp {
 
@@ -57,9 +58,9 @@ PairingPlan PlanKeyframes(double overlap_threshold, std::vector<PairIndex> extra
 /// scheduled differently gives every pair the same result.
 uint64_t PairSeed(uint64_t job_seed, const PairIndex& pair);
 
-/// The paper's overlap thresholds for keyframes: 0.6 for depth images, 0.7
-/// for LiDAR and every other point format.
-double DefaultOverlapThreshold(CloudFormat format);
+/// The paper's overlap thresholds for keyframes: 0.6 for a depth camera, 0.7
+/// for a LiDAR and every other sensor.
+double DefaultOverlapThreshold(SensorKind sensor);
 
 /// Keyframe selection by overlap. Every scan j after the current keyframe k
 /// is registered onto it (pair source = j, target = k) and its overlap is

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/registration/config.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -33,10 +34,10 @@ struct UpDirection {
   std::string reason;     // how `up` was chosen, for the user
 };
 
-/// The up axis of a sensor in its own frame, from its scans' format: a
-/// depth image's camera has y down, a KITTI Velodyne z up; other point
-/// formats do not say (nullopt).
-std::optional<Eigen::Vector3d> SensorUp(CloudFormat format);
+/// The up axis of a sensor in its own frame, from the sensor `set` by the
+/// user, else the scans' format (DeclareSensor): a depth camera has y down,
+/// a LiDAR z up; other formats and sensors do not say (nullopt).
+std::optional<Eigen::Vector3d> SensorUp(const std::optional<SensorKind>& set, CloudFormat format);
 
 /// Finds the map's up direction from occupied cells (centres in the map
 /// frame, metres; edge lengths `sizes`; leaf size `resolution`) and the

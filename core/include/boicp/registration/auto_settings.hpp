@@ -15,8 +15,17 @@
 
 namespace boicp {
 
-enum class SensorKind { kLidar, kDepthCamera, kOther };
-std::string SensorKindName(SensorKind kind);  // "lidar" | "depth camera" | "other"
+/// What is known of the sensor before any geometry is measured.
+struct DeclaredSensor {
+  SensorKind kind = SensorKind::kOther;
+  std::string why;  // "set by --sensor", "KITTI .bin scans (a spinning LiDAR)", "depth images"
+};
+
+/// The user's --sensor (`set`), else what `format` implies: KITTI .bin scans
+/// come from a spinning LiDAR, depth images from a depth camera. nullopt when
+/// neither says, and the geometry decides.
+std::optional<DeclaredSensor> DeclareSensor(const std::optional<SensorKind>& set,
+                                            CloudFormat format);
 
 /// What the settings are chosen from, measured on one cloud in its sensor frame.
 struct CloudStatistics {
@@ -61,19 +70,21 @@ struct ChosenSettings {
   std::vector<size_t> far_returns;  // set aside in each measured cloud, in order
 };
 
-/// The settings for clouds measured by `stats` (at least one), read in
-/// `format` (kAuto when unknown: the sensor then comes from the geometry).
+/// The settings for clouds measured by `stats` (at least one), from the
+/// `declared` sensor (DeclareSensor), else the one the geometry shows.
 /// Throws InputError, naming both scales, when a cloud's RMS radius and point
 /// spacing both differ from the first cloud's by more than 20 times (a
 /// millimetre cloud against a metre one).
-ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats, CloudFormat format);
+ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats,
+                              const std::optional<DeclaredSensor>& declared);
 
 /// Measures up to `max_clouds` of `clouds`, evenly spread (a batch's settings
 /// come from a few scans, so that every pair of it shares them), and chooses;
 /// the clouds are measured on up to `threads` threads at once, which does not
 /// change the choice.
-ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds, CloudFormat format,
-                                       uint64_t seed, size_t max_clouds = 5, int threads = 1);
+ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
+                                       const std::optional<DeclaredSensor>& declared, uint64_t seed,
+                                       size_t max_clouds = 5, int threads = 1);
 
 /// Copies the chosen values into the fields of `config` still listed in
 /// config.automatic (the voxel scaled as the preset's is against C's) and

@@ -2,6 +2,7 @@
 // One configuration struct for a BO-ICP registration, with the paper's presets.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,17 @@ enum class Budget {
 Budget ParseBudget(const std::string& name);  // "auto" | "fixed"; throws InputError
 std::string BudgetName(Budget budget);
 
+/// The kind of sensor a scan comes from, which sets the rotation box, the
+/// map's up and the overlap that pairs keyframes.
+enum class SensorKind { kLidar, kDepthCamera, kOther };
+std::string SensorKindName(SensorKind kind);  // "lidar" | "depth camera" | "other"
+
+/// The --sensor setting: "lidar", "depth" or "object" (kOther), or "auto"
+/// (nullopt: from the file format, else from the scans' geometry). Throws
+/// InputError naming the choices.
+std::optional<SensorKind> ParseSensorSetting(const std::string& name);
+std::string SensorSettingName(const std::optional<SensorKind>& sensor);
+
 /// The library's BO settings with 1000 EI candidates per proposal (see
 /// BoIcpConfig::bo).
 BayesOptOptions RegistrationBayesOptOptions();
@@ -66,6 +78,9 @@ struct BoIcpConfig {
   void MarkSet(const std::string& field);
 
   Budget budget = Budget::kAuto;
+  /// The sensor as the user set it; nullopt: the file format says, else the
+  /// scans' geometry (auto_settings.hpp).
+  std::optional<SensorKind> sensor;
 
   // --- Search (the paper's N_r, N and voxel) -------------------------------
   int random_samples = 30;  // N_r: space-filling samples per search stage

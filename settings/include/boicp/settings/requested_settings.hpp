@@ -23,6 +23,7 @@ struct RequestedSettings {
   std::string mode = "nested";          // nested | 6dof
   std::string icp_objective = "plane";  // plane | point: the search evaluations' ICP
   std::string budget = "auto";          // auto (the escalation ladder) | fixed (the full search)
+  std::string sensor = "auto";          // lidar | depth | object | auto (format, then geometry)
   uint64_t seed = 1;                    // job seed; each pair's seed derives from it
   bool fixed_settings = false;          // the preset's fixed voxel, bounds and map settings
   bool no_retry = false;                // never search a doubtful pair again
