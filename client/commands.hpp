@@ -26,6 +26,7 @@ CommandRunner AddWatchCommand(CLI::App& app);
 CommandRunner AddJobsCommand(CLI::App& app);
 CommandRunner AddShowCommand(CLI::App& app);
 CommandRunner AddCancelCommand(CLI::App& app);
+CommandRunner AddDeleteCommand(CLI::App& app);
 CommandRunner AddExportCommand(CLI::App& app);
 CommandRunner AddHealthCommand(CLI::App& app);
 #endif

@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
   add(show, boicp::cli::AddShowCommand(*show));
   CLI::App* cancel = app.add_subcommand("cancel", "Cancel a queued or running job");
   add(cancel, boicp::cli::AddCancelCommand(*cancel));
+  CLI::App* remove = app.add_subcommand("delete", "Delete a finished job and its outputs");
+  add(remove, boicp::cli::AddDeleteCommand(*remove));
   CLI::App* exporter = app.add_subcommand("export", "Download a finished job's map or trajectory");
   add(exporter, boicp::cli::AddExportCommand(*exporter));
   CLI::App* health = app.add_subcommand("health", "Check that the daemon is serving");

@@ -108,6 +108,8 @@ std::string DataDir::JobDir(const std::string& job_id) const {
   return (fs::path(root_) / "jobs" / job_id).string();
 }
 
+std::string DataDir::JobsRoot() const { return (fs::path(root_) / "jobs").string(); }
+
 std::vector<std::string> DataDir::WritableDirs() const {
   std::vector<std::string> dirs = {root_};
   for (const char* sub : kSubdirs) dirs.push_back((fs::path(root_) / sub).string());

@@ -31,6 +31,8 @@ class DataDir {
   /// False for an id that is not a scan id.
   bool HasScanFile(const std::string& scan_id) const;
   std::string JobDir(const std::string& job_id) const;
+  /// The folder of every job's folder (jobs/).
+  std::string JobsRoot() const;
   /// Creates the job's directory (and any missing parent), each synced into
   /// its parent. Returns its path. Throws StorageError.
   std::string CreateJobDir(const std::string& job_id) const;

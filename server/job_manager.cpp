@@ -1,6 +1,7 @@
 #include "job_manager.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
 #include <spdlog/spdlog.h>
 
@@ -13,8 +14,26 @@
 namespace boicp::server {
 namespace {
 
+namespace fs = std::filesystem;
+
 // Runs of one job the daemon may die in before the job is failed instead of resumed.
 constexpr int kMaxUnendedRuns = 2;
+
+// Removes `path` and everything under it; returns the bytes its files held.
+// A failure is logged, not thrown: the job it belonged to is already gone,
+// and the next start removes what is left.
+uint64_t RemoveTree(const std::string& path) {
+  uint64_t bytes = 0;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(path, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    std::error_code size_error;
+    if (it->is_regular_file(size_error)) bytes += it->file_size(size_error);
+  }
+  fs::remove_all(path, ec);
+  if (ec) spdlog::warn("cannot remove {}: {}", path, ec.message());
+  return bytes;
+}
 
 }  // namespace
 
@@ -30,6 +49,7 @@ JobManager::~JobManager() { Drain(); }
 
 void JobManager::Start() {
   std::lock_guard<std::mutex> lock(mutex_);
+  RemoveOrphanJobDirs();
   for (v1::Job& job : store_.UnfinishedJobs()) {
     if (job.cancel_requested()) {
       // Cancelled while a previous daemon ran it: finish the cancellation.
@@ -149,6 +169,34 @@ v1::Job JobManager::Cancel(const std::string& job_id) {
     spdlog::info("job {} cancel requested", job_id);
   }
   return *job;
+}
+
+v1::DeleteJobResponse JobManager::Delete(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::optional<v1::Job> job = store_.DeleteFinishedJob(job_id);
+  if (!job) throw ServiceError(grpc::StatusCode::NOT_FOUND, "no job '" + job_id + "'");
+  if (!rpc::IsTerminal(job->state())) {
+    throw ServiceError(grpc::StatusCode::FAILED_PRECONDITION,
+                       "job " + job_id + " is " + rpc::JobStateName(job->state()) +
+                           "; cancel it first (boicp cancel " + job_id + ")");
+  }
+  v1::DeleteJobResponse response;
+  response.set_job_id(job_id);
+  response.set_bytes_freed(RemoveTree(data_dir_.JobDir(job_id)));
+  spdlog::info("job {} deleted: {} bytes of outputs freed", job_id, response.bytes_freed());
+  return response;
+}
+
+void JobManager::RemoveOrphanJobDirs() {
+  const std::set<std::string> jobs = store_.JobIds();
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(data_dir_.JobsRoot(), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (jobs.count(name) != 0) continue;
+    const uint64_t bytes = RemoveTree(entry.path().string());
+    spdlog::info("removed {} ({} bytes): no job has it (a deletion the last daemon did not finish)",
+                 entry.path().string(), bytes);
+  }
 }
 
 bool JobManager::Drain(std::chrono::milliseconds timeout) {

@@ -59,6 +59,12 @@ class JobManager {
   /// Throws ServiceError NOT_FOUND.
   v1::Job Cancel(const std::string& job_id);
 
+  /// Deletes a succeeded, failed or cancelled job: its rows go in one
+  /// transaction, then its output folder. A daemon killed in between leaves
+  /// no job and a folder that Start() removes. Throws ServiceError NOT_FOUND,
+  /// or FAILED_PRECONDITION while the job is queued or running.
+  v1::DeleteJobResponse Delete(const std::string& job_id);
+
   /// Stops accepting, interrupts running jobs (finished pairs are already
   /// stored; they stay resumable) and joins every thread once they stopped.
   /// Returns false, with the jobs still stopping, when that takes longer
@@ -66,6 +72,8 @@ class JobManager {
   bool Drain(std::chrono::milliseconds timeout = std::chrono::milliseconds::max());
 
  private:
+  /// Removes folders under jobs/ that no stored job owns.
+  void RemoveOrphanJobDirs();
   void RunSlot();
   void RunTracked(const v1::Job& job, JobControl& control);
   void Publish(const v1::Job& job);

@@ -180,6 +180,26 @@ v1::Job JobStore::CreateJob(v1::Job job, const JobInput& input) {
   return job;
 }
 
+std::optional<v1::Job> JobStore::DeleteFinishedJob(const std::string& job_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  SqliteDatabase::Transaction transaction(db_);
+  std::optional<v1::Job> job = ReadJob(job_id);
+  if (!job || !rpc::IsTerminal(job->state())) return job;
+  for (const char* table : {"pair_results", "trajectories", "job_scans", "jobs"}) {
+    db_.Prepare(std::string("DELETE FROM ") + table + " WHERE job_id = ?1").Bind(1, job_id).Run();
+  }
+  transaction.Commit();
+  return job;
+}
+
+std::set<std::string> JobStore::JobIds() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::set<std::string> ids;
+  auto stmt = db_.Prepare("SELECT job_id FROM jobs");
+  while (stmt.Step()) ids.insert(stmt.ColumnText(0));
+  return ids;
+}
+
 bool JobStore::UpdateJob(const v1::Job& job) {
   std::lock_guard<std::mutex> lock(mutex_);
   SqliteDatabase::Transaction transaction(db_);

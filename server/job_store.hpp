@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,12 @@ class JobStore {
   /// as stored afterwards (unchanged when already final), nullopt if unknown.
   std::optional<v1::Job> RequestCancel(const std::string& job_id);
   std::optional<v1::Job> GetJob(const std::string& job_id);
+  /// Deletes a final job's rows (job, scans list, pairs, trajectory) in one
+  /// transaction. Returns the job as it was, nullopt when unknown; an
+  /// unfinished job is returned and kept.
+  std::optional<v1::Job> DeleteFinishedJob(const std::string& job_id);
+  /// Every job id the store holds.
+  std::set<std::string> JobIds();
   std::optional<JobInput> GetJobInput(const std::string& job_id);
   /// Newest first. `page_token` is opaque (empty = first page); throws
   /// InputError for a token this store did not hand out.

@@ -119,6 +119,16 @@ grpc::ServerUnaryReactor* MapBuilderService::CancelJob(grpc::CallbackServerConte
   });
 }
 
+grpc::ServerUnaryReactor* MapBuilderService::DeleteJob(grpc::CallbackServerContext* context,
+                                                       const v1::DeleteJobRequest* request,
+                                                       v1::DeleteJobResponse* response) {
+  return Unary(deps_, context, "DeleteJob", [&] {
+    RequireJobId(request->job_id());
+    *response = deps_.manager.Delete(request->job_id());
+    return grpc::Status::OK;
+  });
+}
+
 grpc::ServerWriteReactor<v1::JobEvent>* MapBuilderService::WatchJob(
     grpc::CallbackServerContext* context, const v1::WatchJobRequest* request) {
   grpc::Status status = deps_.auth.Check(*context);

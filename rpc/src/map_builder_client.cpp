@@ -135,6 +135,16 @@ v1::Job MapBuilderClient::Cancel(const std::string& job_id) {
   return job;
 }
 
+v1::DeleteJobResponse MapBuilderClient::Delete(const std::string& job_id) {
+  grpc::ClientContext context;
+  PrepareUnary(context);
+  v1::DeleteJobRequest request;
+  request.set_job_id(job_id);
+  v1::DeleteJobResponse response;
+  Check("DeleteJob", stub_->DeleteJob(&context, request, &response));
+  return response;
+}
+
 v1::ListJobsResponse MapBuilderClient::ListJobs(uint32_t page_size, const std::string& page_token) {
   grpc::ClientContext context;
   PrepareUnary(context);

@@ -298,6 +298,14 @@ TEST_F(RemoteCli, CancelStopsAJobWatchExitsOneAndHealthServes) {
   EXPECT_EQ(Lines(exported.err).size(), 1u) << exported.err;
   EXPECT_THAT(exported.err, HasSubstr("only a succeeded job"));
   EXPECT_FALSE(fs::exists(dir_ / "m.bt"));
+
+  // A cancelled job can be deleted; then it is gone.
+  const RunResult deleted = Run("delete " + job + server_);
+  EXPECT_EQ(deleted.exit_code, 0) << deleted.err;
+  EXPECT_THAT(deleted.err, HasSubstr("job " + job + " deleted ("));
+  const RunResult gone = Run("show " + job + server_);
+  EXPECT_EQ(gone.exit_code, 2);
+  EXPECT_THAT(gone.err, HasSubstr("no job '" + job + "'"));
 }
 
 TEST_F(RemoteCli, UnreachableDaemonFailsWithOneLine) {
@@ -306,7 +314,7 @@ TEST_F(RemoteCli, UnreachableDaemonFailsWithOneLine) {
   const std::string server = " --server " + address;
   for (const std::string& args : std::vector<std::string>{
            "jobs", "health", "show job-000001", "watch job-000001", "cancel job-000001",
-           "export job-000001 -o " + (dir_ / "m.bt").string(),
+           "delete job-000001", "export job-000001 -o " + (dir_ / "m.bt").string(),
            "submit " + (dir_ / "drive").string()}) {
     const RunResult r = Run(args + server);
     EXPECT_NE(r.exit_code, 0) << args;
@@ -318,9 +326,9 @@ TEST_F(RemoteCli, UnreachableDaemonFailsWithOneLine) {
 
 TEST_F(RemoteCli, UnknownJobAndBadInputGiveOneLineErrors) {
   StartDaemon();
-  for (const std::string& args :
-       std::vector<std::string>{"show job-999999", "watch job-999999", "cancel job-999999",
-                                "export job-999999 -o " + (dir_ / "m.bt").string()}) {
+  for (const std::string& args : std::vector<std::string>{
+           "show job-999999", "watch job-999999", "cancel job-999999", "delete job-999999",
+           "export job-999999 -o " + (dir_ / "m.bt").string()}) {
     const RunResult r = Run(args + server_);
     EXPECT_EQ(r.exit_code, 2) << args;
     EXPECT_EQ(Lines(r.err).size(), 1u) << args << ":\n" << r.err;

@@ -51,7 +51,7 @@ class MapBuilderClient {
   v1::MapBuilder::Stub& stub() { return *stub_; }
 
   /// Deadline for each unary call (FindScans, SubmitBatch, GetJob, ListJobs,
-  /// CancelJob, GetResults), so that an unreachable daemon fails in seconds.
+  /// CancelJob, DeleteJob, GetResults), so that an unreachable daemon fails in seconds.
   /// Streams (upload, watch, export) never get one. 0 (the default) = none.
   void set_unary_timeout(std::chrono::milliseconds timeout) { unary_timeout_ = timeout; }
 
@@ -66,6 +66,7 @@ class MapBuilderClient {
   v1::Job Submit(const v1::SubmitBatchRequest& request);
   v1::Job GetJob(const std::string& job_id);
   v1::Job Cancel(const std::string& job_id);
+  v1::DeleteJobResponse Delete(const std::string& job_id);
   /// One page of jobs, newest first; page_size 0 = the daemon's default (50).
   v1::ListJobsResponse ListJobs(uint32_t page_size = 0, const std::string& page_token = "");
   v1::JobResults Results(const std::string& job_id);

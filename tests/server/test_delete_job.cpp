@@ -1,0 +1,85 @@
+// DeleteJob: a finished job goes with its rows and outputs, a running one
+// stays, and a folder a killed deletion left behind is removed at start.
+
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+
+#include "server_fixture.hpp"
+
+namespace boicp::test {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+class DeleteJob : public ServerTest {
+ protected:
+  // The status code of `call`, OK when it does not throw.
+  template <typename Call>
+  static grpc::StatusCode CodeOf(Call call, std::string* message = nullptr) {
+    try {
+      call();
+    } catch (const rpc::RpcError& e) {
+      if (message != nullptr) *message = e.what();
+      return e.code();
+    }
+    return grpc::StatusCode::OK;
+  }
+};
+
+TEST_F(DeleteJob, AFinishedJobGoesWithItsOutputsAndItsScansStay) {
+  StartDaemon();
+  auto client = Client();
+  const auto ids = UploadDrive(client, 3, 61);
+  const std::string job_id = client.Submit(QuickBatch(ids)).job_id();
+  ASSERT_EQ(client.Watch(job_id).state(), v1::JOB_STATE_SUCCEEDED);
+  const fs::path outputs = data_dir_ / "jobs" / job_id;
+  ASSERT_TRUE(fs::exists(outputs / "map.bt"));
+
+  const v1::DeleteJobResponse deleted = client.Delete(job_id);
+  EXPECT_EQ(deleted.job_id(), job_id);
+  EXPECT_GT(deleted.bytes_freed(), 1000u);
+  EXPECT_FALSE(fs::exists(outputs));
+  EXPECT_EQ(CodeOf([&] { client.GetJob(job_id); }), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] { client.Results(job_id); }), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(CodeOf([&] { client.Delete(job_id); }), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(client.ListJobs(10).jobs_size(), 0);
+  // The scans serve the next job without another upload.
+  EXPECT_EQ(client.Watch(client.Submit(QuickBatch(ids)).job_id()).state(), v1::JOB_STATE_SUCCEEDED);
+}
+
+TEST_F(DeleteJob, ARunningJobIsRefusedUntilCancelled) {
+  StartDaemon({"--workers", "1", "--jobs", "1"});
+  auto client = Client();
+  const std::string job_id = client.Submit(SlowBatch(UploadDrive(client, 4, 62))).job_id();
+  std::string message;
+  EXPECT_EQ(CodeOf([&] { client.Delete(job_id); }, &message),
+            grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(message, HasSubstr("cancel it first (boicp cancel " + job_id + ")"));
+  client.Cancel(job_id);
+  ASSERT_EQ(client.Watch(job_id).state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_EQ(client.Delete(job_id).job_id(), job_id);
+  EXPECT_EQ(CodeOf([&] { client.GetJob(job_id); }), grpc::StatusCode::NOT_FOUND);
+}
+
+// A daemon killed between the rows' transaction and the folder's removal
+// leaves a folder no job owns: the next start removes it, and only it.
+TEST_F(DeleteJob, AFolderNoJobOwnsIsRemovedAtStart) {
+  StartDaemon();
+  auto client = Client();
+  const std::string kept = client.Submit(QuickBatch(UploadDrive(client, 3, 63))).job_id();
+  ASSERT_EQ(client.Watch(kept).state(), v1::JOB_STATE_SUCCEEDED);
+  StopDaemon();
+  const fs::path orphan = data_dir_ / "jobs" / "job-999999";
+  fs::create_directories(orphan);
+  std::ofstream(orphan / "map.bt") << "left by a deletion the daemon did not finish";
+  StartDaemon();
+  EXPECT_FALSE(fs::exists(orphan));
+  EXPECT_TRUE(fs::exists(data_dir_ / "jobs" / kept / "map.bt"));
+  EXPECT_EQ(Client().GetJob(kept).state(), v1::JOB_STATE_SUCCEEDED);
+}
+
+}  // namespace
+}  // namespace boicp::test
