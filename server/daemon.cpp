@@ -50,6 +50,7 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_options.max_batch_scans = options_.max_batch_scans;
   manager_options.max_scan_points = options_.max_scan_points;
   manager_options.min_free_bytes = min_free_bytes;
+  manager_options.retain_seconds = options_.retain_days * 86400.0;
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
                                             options_.max_upload_bytes_in_flight);

@@ -81,6 +81,11 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "Seconds an upload may send nothing before it is cancelled")
       ->capture_default_str()
       ->envname("BOICPD_UPLOAD_IDLE_TIMEOUT");
+  app.add_option("--retain-days", o.retain_days,
+                 "Delete succeeded, failed and cancelled jobs (records and outputs, not scans) "
+                 "this many days after they end; 0 keeps them until boicp delete")
+      ->capture_default_str()
+      ->envname("BOICPD_RETAIN_DAYS");
   app.add_option("--auth-token-file", o.auth_token_file,
                  "Require 'authorization: Bearer <token>' with the token in this file")
       ->envname("BOICPD_AUTH_TOKEN_FILE");
@@ -115,6 +120,7 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.max_scan_points >= 1, "--max-scan-points must be at least 1");
   require(o.min_free_mb <= (uint64_t{1} << 40), "--min-free-mb must be at most 2^40");
   require(o.shutdown_grace_s >= 0.0, "--shutdown-grace must be >= 0");
+  require(o.retain_days >= 0.0 && o.retain_days <= 1e5, "--retain-days must be in 0..100000");
   require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");
   require(o.tls_client_ca.empty() || !o.tls_cert.empty(), "--tls-client-ca needs --tls-cert");
   require(o.max_concurrent_uploads >= 1 && o.max_concurrent_uploads <= 10000,

@@ -20,6 +20,7 @@ struct DaemonOptions {
   uint64_t max_scan_bytes = 256ull << 20;  // per uploaded scan
   uint64_t max_scan_points = 5000000;      // per scan, after decoding (about 20 128-beam sweeps)
   uint64_t min_free_mb = 1024;  // MiB kept free in the data directory; new work is refused below
+  double retain_days = 0.0;     // finished jobs older than this are deleted; 0 = kept for good
   int max_concurrent_uploads = 8;
   uint64_t max_upload_bytes_in_flight = 1ull << 30;  // announced by the uploads streaming at once
   int max_concurrent_streams = 100;                  // calls open at once on one connection

@@ -84,6 +84,7 @@ void JobManager::Start() {
   for (int i = 0; i < std::max(options_.concurrent_jobs, 1); ++i) {
     slots_.emplace_back([this] { RunSlot(); });
   }
+  if (options_.retain_seconds > 0.0) retention_ = std::thread([this] { RunRetention(); });
 }
 
 v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
@@ -187,6 +188,26 @@ v1::DeleteJobResponse JobManager::Delete(const std::string& job_id) {
   return response;
 }
 
+void JobManager::RunRetention() {
+  // A quarter of the retention between sweeps, so that a job outlives it by
+  // at most a quarter; at least a second and at most an hour.
+  const auto interval =
+      std::chrono::duration<double>(std::clamp(options_.retain_seconds / 4.0, 1.0, 3600.0));
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!queue_changed_.wait_for(lock, interval, [this] { return draining_; })) {
+    lock.unlock();
+    const double cutoff = rpc::NowSeconds() - options_.retain_seconds;
+    for (const std::string& job_id : store_.JobsFinishedBefore(cutoff)) {
+      try {
+        Delete(job_id);
+      } catch (const std::exception& e) {
+        spdlog::warn("job {}: past its retention but not deleted: {}", job_id, e.what());
+      }
+    }
+    lock.lock();
+  }
+}
+
 void JobManager::RemoveOrphanJobDirs() {
   const std::set<std::string> jobs = store_.JobIds();
   std::error_code ec;
@@ -217,6 +238,7 @@ bool JobManager::Drain(std::chrono::milliseconds timeout) {
   }
   for (std::thread& slot : slots_) slot.join();
   slots_.clear();
+  if (retention_.joinable()) retention_.join();
   pool_.reset();  // every task has returned: each runner waited for its own
   return true;
 }

@@ -33,6 +33,7 @@ struct ManagerOptions {
   int max_batch_scans = 100000;        // scans per batch; more is RESOURCE_EXHAUSTED
   uint64_t max_scan_points = 5000000;  // points per stored scan; more is RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;  // below it (or unwritable) new batches are FAILED_PRECONDITION
+  double retain_seconds = 0.0;  // finished jobs older than this are deleted; 0 = kept for good
 };
 
 class JobManager {
@@ -74,6 +75,9 @@ class JobManager {
  private:
   /// Removes folders under jobs/ that no stored job owns.
   void RemoveOrphanJobDirs();
+  /// Deletes the jobs that finished over options_.retain_seconds ago, now
+  /// and then until the manager drains.
+  void RunRetention();
   void RunSlot();
   void RunTracked(const v1::Job& job, JobControl& control);
   void Publish(const v1::Job& job);
@@ -93,6 +97,7 @@ class JobManager {
   bool accepting_ = false;
   bool draining_ = false;
   std::vector<std::thread> slots_;
+  std::thread retention_;
 };
 
 }  // namespace boicp::server

@@ -200,6 +200,17 @@ std::set<std::string> JobStore::JobIds() {
   return ids;
 }
 
+std::vector<std::string> JobStore::JobsFinishedBefore(double cutoff) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> ids;
+  auto stmt = db_.Prepare("SELECT job FROM jobs");
+  while (stmt.Step()) {
+    const auto job = Parse<v1::Job>(stmt.ColumnBlob(0), "job");
+    if (rpc::IsTerminal(job.state()) && job.finished_at() < cutoff) ids.push_back(job.job_id());
+  }
+  return ids;
+}
+
 bool JobStore::UpdateJob(const v1::Job& job) {
   std::lock_guard<std::mutex> lock(mutex_);
   SqliteDatabase::Transaction transaction(db_);

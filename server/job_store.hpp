@@ -67,6 +67,8 @@ class JobStore {
   std::optional<v1::Job> DeleteFinishedJob(const std::string& job_id);
   /// Every job id the store holds.
   std::set<std::string> JobIds();
+  /// The final jobs whose finished_at (seconds since the epoch) is before `cutoff`.
+  std::vector<std::string> JobsFinishedBefore(double cutoff);
   std::optional<JobInput> GetJobInput(const std::string& job_id);
   /// Newest first. `page_token` is opaque (empty = first page); throws
   /// InputError for a token this store did not hand out.

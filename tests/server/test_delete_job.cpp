@@ -1,8 +1,10 @@
 // DeleteJob: a finished job goes with its rows and outputs, a running one
 // stays, and a folder a killed deletion left behind is removed at start.
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <gmock/gmock.h>
 
@@ -62,6 +64,21 @@ TEST_F(DeleteJob, ARunningJobIsRefusedUntilCancelled) {
   ASSERT_EQ(client.Watch(job_id).state(), v1::JOB_STATE_CANCELLED);
   EXPECT_EQ(client.Delete(job_id).job_id(), job_id);
   EXPECT_EQ(CodeOf([&] { client.GetJob(job_id); }), grpc::StatusCode::NOT_FOUND);
+}
+
+// --retain-days 0.00003 (2.6 s): a finished job goes by itself.
+TEST_F(DeleteJob, FinishedJobsPastTheirRetentionAreDeleted) {
+  StartDaemon({"--workers", "2", "--retain-days", "0.00003"});
+  auto client = Client();
+  const std::string job_id = client.Submit(QuickBatch(UploadDrive(client, 3, 64))).job_id();
+  ASSERT_EQ(client.Watch(job_id).state(), v1::JOB_STATE_SUCCEEDED);
+  const auto started = std::chrono::steady_clock::now();
+  while (CodeOf([&] { client.GetJob(job_id); }) == grpc::StatusCode::OK &&
+         std::chrono::steady_clock::now() - started < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  EXPECT_EQ(CodeOf([&] { client.GetJob(job_id); }), grpc::StatusCode::NOT_FOUND);
+  EXPECT_FALSE(fs::exists(data_dir_ / "jobs" / job_id));
 }
 
 // A daemon killed between the rows' transaction and the folder's removal
