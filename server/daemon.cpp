@@ -39,6 +39,7 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
 
   data_dir_ = std::make_unique<DataDir>(options_.data_dir);
   const uint64_t min_free_bytes = options_.min_free_mb << 20;
+  const auto max_stored_bytes = static_cast<uint64_t>(options_.max_stored_gb * 1e9);
   RequireStorage(*data_dir_, min_free_bytes);
   store_ = std::make_unique<JobStore>(data_dir_->DatabasePath());
   watches_ = std::make_unique<WatchHub>();
@@ -51,13 +52,15 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_options.max_scan_points = options_.max_scan_points;
   manager_options.min_free_bytes = min_free_bytes;
   manager_options.retain_seconds = options_.retain_days * 86400.0;
+  manager_options.scan_grace_seconds = options_.scan_grace_hours * 3600.0;
+  manager_options.max_stored_bytes = max_stored_bytes;
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
                                             options_.max_upload_bytes_in_flight);
   idle_uploads_ = std::make_unique<IdleUploads>(std::chrono::seconds(options_.upload_idle_s));
-  service_ = std::make_unique<MapBuilderService>(
-      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *idle_uploads_,
-                  options_.max_scan_bytes, options_.max_scan_points, min_free_bytes});
+  service_ = std::make_unique<MapBuilderService>(ServiceDeps{
+      *store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *idle_uploads_,
+      options_.max_scan_bytes, options_.max_scan_points, min_free_bytes, max_stored_bytes});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

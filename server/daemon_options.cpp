@@ -86,6 +86,16 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "this many days after they end; 0 keeps them until boicp delete")
       ->capture_default_str()
       ->envname("BOICPD_RETAIN_DAYS");
+  app.add_option("--scan-grace-hours", o.scan_grace_hours,
+                 "Delete an uploaded scan no job uses this many hours after it was last "
+                 "uploaded, found or used")
+      ->capture_default_str()
+      ->envname("BOICPD_SCAN_GRACE_HOURS");
+  app.add_option("--max-stored-gb", o.max_stored_gb,
+                 "Refuse uploads (RESOURCE_EXHAUSTED) once scans and outputs take this many GB; "
+                 "0 = no cap (the free-space reserve still holds)")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_STORED_GB");
   app.add_option("--auth-token-file", o.auth_token_file,
                  "Require 'authorization: Bearer <token>' with the token in this file")
       ->envname("BOICPD_AUTH_TOKEN_FILE");
@@ -121,6 +131,9 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.min_free_mb <= (uint64_t{1} << 40), "--min-free-mb must be at most 2^40");
   require(o.shutdown_grace_s >= 0.0, "--shutdown-grace must be >= 0");
   require(o.retain_days >= 0.0 && o.retain_days <= 1e5, "--retain-days must be in 0..100000");
+  require(o.scan_grace_hours >= 0.0 && o.scan_grace_hours <= 1e6,
+          "--scan-grace-hours must be in 0..1000000");
+  require(o.max_stored_gb >= 0.0 && o.max_stored_gb <= 1e7, "--max-stored-gb must be in 0..1e7");
   require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");
   require(o.tls_client_ca.empty() || !o.tls_cert.empty(), "--tls-client-ca needs --tls-cert");
   require(o.max_concurrent_uploads >= 1 && o.max_concurrent_uploads <= 10000,

@@ -19,8 +19,10 @@ struct DaemonOptions {
   int max_message_bytes = 4 << 20;         // gRPC receive limit per message
   uint64_t max_scan_bytes = 256ull << 20;  // per uploaded scan
   uint64_t max_scan_points = 5000000;      // per scan, after decoding (about 20 128-beam sweeps)
-  uint64_t min_free_mb = 1024;  // MiB kept free in the data directory; new work is refused below
-  double retain_days = 0.0;     // finished jobs older than this are deleted; 0 = kept for good
+  uint64_t min_free_mb = 1024;     // MiB kept free in the data directory; new work is refused below
+  double retain_days = 0.0;        // finished jobs older than this are deleted; 0 = kept for good
+  double scan_grace_hours = 24.0;  // scans no job uses are deleted this long after their last use
+  double max_stored_gb = 0.0;      // scans and outputs; uploads over it are refused; 0 = no cap
   int max_concurrent_uploads = 8;
   uint64_t max_upload_bytes_in_flight = 1ull << 30;  // announced by the uploads streaming at once
   int max_concurrent_streams = 100;                  // calls open at once on one connection

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include <spdlog/spdlog.h>
+
 #include "boicp/rpc/sha256.hpp"
 #include "boicp/util/types.hpp"
 #include "storage_errors.hpp"
@@ -49,6 +51,18 @@ std::error_code CreateDurableDirectories(const fs::path& dir) {
   return error;
 }
 
+// Bytes of the files under `path` (0 when it is missing).
+uint64_t TreeBytes(const fs::path& path) {
+  uint64_t bytes = 0;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(path, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    std::error_code size_error;
+    if (it->is_regular_file(size_error)) bytes += it->file_size(size_error);
+  }
+  return bytes;
+}
+
 void RequireDurableDirectories(const fs::path& dir) {
   if (const std::error_code error = CreateDurableDirectories(dir)) {
     throw StorageError("cannot create " + dir.string() + " (" + error.message() + ")");
@@ -85,6 +99,8 @@ DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_n
     ::close(lock_fd_);
     throw StorageError("data directory " + root_ + ": cannot read tmp/ (" + error.message() + ")");
   }
+  scan_bytes_ = TreeBytes(fs::path(root_) / "scans");
+  for (const std::string& name : JobDirNames()) job_bytes_[name] = TreeBytes(JobDir(name));
 }
 
 DataDir::~DataDir() {
@@ -110,6 +126,69 @@ std::string DataDir::JobDir(const std::string& job_id) const {
 
 std::string DataDir::JobsRoot() const { return (fs::path(root_) / "jobs").string(); }
 
+std::vector<std::string> DataDir::JobDirNames() const {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (fs::directory_iterator it(JobsRoot(), ec), end; !ec && it != end; it.increment(ec)) {
+    names.push_back(it->path().filename().string());
+  }
+  return names;
+}
+
+uint64_t DataDir::StoredBytes() const {
+  std::lock_guard<std::mutex> lock(bytes_mutex_);
+  uint64_t bytes = scan_bytes_;
+  for (const auto& entry : job_bytes_) bytes += entry.second;
+  return bytes;
+}
+
+void DataDir::RecountJobDir(const std::string& job_id) {
+  const uint64_t bytes = TreeBytes(JobDir(job_id));
+  std::lock_guard<std::mutex> lock(bytes_mutex_);
+  job_bytes_[job_id] = bytes;
+}
+
+uint64_t DataDir::RemoveJobDir(const std::string& job_id) {
+  const fs::path dir = JobDir(job_id);
+  const uint64_t bytes = TreeBytes(dir);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  if (ec) spdlog::warn("cannot remove {}: {}", dir.string(), ec.message());
+  std::lock_guard<std::mutex> lock(bytes_mutex_);
+  job_bytes_.erase(job_id);
+  return bytes;
+}
+
+uint64_t DataDir::RemoveScanFile(const std::string& scan_id) {
+  const std::string path = ScanPath(scan_id);
+  std::error_code ec;
+  const uint64_t bytes = fs::file_size(path, ec);
+  if (ec || !fs::remove(path, ec)) return 0;
+  std::lock_guard<std::mutex> lock(bytes_mutex_);
+  scan_bytes_ -= std::min(scan_bytes_, bytes);
+  return bytes;
+}
+
+void DataDir::TouchScan(const std::string& scan_id) const {
+  std::error_code ignored;
+  fs::last_write_time(ScanPath(scan_id), fs::file_time_type::clock::now(), ignored);
+}
+
+std::vector<std::string> DataDir::ScansUnusedSince(fs::file_time_type cutoff) const {
+  std::vector<std::string> ids;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(fs::path(root_) / "scans", ec), end; !ec && it != end;
+       it.increment(ec)) {
+    std::error_code time_error;
+    const std::string name = it->path().filename().string();
+    if (it->is_regular_file(time_error) && rpc::IsSha256Hex(name) &&
+        it->last_write_time(time_error) < cutoff && !time_error) {
+      ids.push_back(name);
+    }
+  }
+  return ids;
+}
+
 std::vector<std::string> DataDir::WritableDirs() const {
   std::vector<std::string> dirs = {root_};
   for (const char* sub : kSubdirs) dirs.push_back((fs::path(root_) / sub).string());
@@ -128,17 +207,21 @@ std::string DataDir::CreateJobDir(const std::string& job_id) const {
   return dir;
 }
 
-void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) const {
+void DataDir::CommitScan(const std::string& tmp_path, const std::string& scan_id) {
   const fs::path target = ScanPath(scan_id);
   RequireDurableDirectories(target.parent_path());
   std::error_code error;
   FsyncPath(tmp_path, O_RDONLY);
+  std::error_code size_error;
+  const uint64_t bytes = fs::file_size(tmp_path, size_error);
   fs::rename(tmp_path, target, error);
   if (error) {
     throw StorageError("cannot store scan " + scan_id.substr(0, 12) + " in " + root_ + " (" +
                        error.message() + ")");
   }
   FsyncPath(target.parent_path().string(), O_RDONLY | O_DIRECTORY);
+  std::lock_guard<std::mutex> lock(bytes_mutex_);
+  if (!size_error) scan_bytes_ += bytes;
 }
 
 }  // namespace boicp::server

@@ -19,22 +19,6 @@ namespace fs = std::filesystem;
 // Runs of one job the daemon may die in before the job is failed instead of resumed.
 constexpr int kMaxUnendedRuns = 2;
 
-// Removes `path` and everything under it; returns the bytes its files held.
-// A failure is logged, not thrown: the job it belonged to is already gone,
-// and the next start removes what is left.
-uint64_t RemoveTree(const std::string& path) {
-  uint64_t bytes = 0;
-  std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(path, ec);
-       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-    std::error_code size_error;
-    if (it->is_regular_file(size_error)) bytes += it->file_size(size_error);
-  }
-  fs::remove_all(path, ec);
-  if (ec) spdlog::warn("cannot remove {}: {}", path, ec.message());
-  return bytes;
-}
-
 }  // namespace
 
 JobManager::JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
@@ -84,7 +68,7 @@ void JobManager::Start() {
   for (int i = 0; i < std::max(options_.concurrent_jobs, 1); ++i) {
     slots_.emplace_back([this] { RunSlot(); });
   }
-  if (options_.retain_seconds > 0.0) retention_ = std::thread([this] { RunRetention(); });
+  housekeeping_ = std::thread([this] { RunHousekeeping(); });
 }
 
 v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
@@ -120,6 +104,15 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   if (!accepting_) {
     throw ServiceError(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down");
   }
+  // Unused scans are collected under this lock, so the batch's scans found
+  // above are checked again here, then stay in use.
+  for (int i = 0; i < request.scan_ids_size(); ++i) {
+    if (!data_dir_.HasScanFile(request.scan_ids(i))) {
+      throw InputError("scan_ids[" + std::to_string(i) + "]: scan '" + request.scan_ids(i) +
+                       "' was deleted, unused, meanwhile (upload it again)");
+    }
+  }
+  RequireStoredQuota(data_dir_, options_.max_stored_bytes);
   if (static_cast<int>(queue_.size()) >= options_.max_queued_jobs) {
     throw ServiceError(grpc::StatusCode::RESOURCE_EXHAUSTED,
                        "the queue is full: " + std::to_string(queue_.size()) +
@@ -183,40 +176,67 @@ v1::DeleteJobResponse JobManager::Delete(const std::string& job_id) {
   }
   v1::DeleteJobResponse response;
   response.set_job_id(job_id);
-  response.set_bytes_freed(RemoveTree(data_dir_.JobDir(job_id)));
+  response.set_bytes_freed(data_dir_.RemoveJobDir(job_id));
   spdlog::info("job {} deleted: {} bytes of outputs freed", job_id, response.bytes_freed());
+  CollectUnusedScans();
   return response;
 }
 
-void JobManager::RunRetention() {
-  // A quarter of the retention between sweeps, so that a job outlives it by
-  // at most a quarter; at least a second and at most an hour.
-  const auto interval =
-      std::chrono::duration<double>(std::clamp(options_.retain_seconds / 4.0, 1.0, 3600.0));
+void JobManager::RunHousekeeping() {
+  // A quarter of the shorter period between sweeps, so that a job or scan
+  // outlives its time by at most a quarter; at least a second, at most an hour.
+  double period = options_.scan_grace_seconds;
+  if (options_.retain_seconds > 0.0) period = std::min(period, options_.retain_seconds);
+  const auto interval = std::chrono::duration<double>(std::clamp(period / 4.0, 1.0, 3600.0));
   std::unique_lock<std::mutex> lock(mutex_);
-  while (!queue_changed_.wait_for(lock, interval, [this] { return draining_; })) {
+  while (!draining_started_.wait_for(lock, interval, [this] { return draining_; })) {
     lock.unlock();
-    const double cutoff = rpc::NowSeconds() - options_.retain_seconds;
-    for (const std::string& job_id : store_.JobsFinishedBefore(cutoff)) {
-      try {
-        Delete(job_id);
-      } catch (const std::exception& e) {
-        spdlog::warn("job {}: past its retention but not deleted: {}", job_id, e.what());
+    if (options_.retain_seconds > 0.0) {
+      const double cutoff = rpc::NowSeconds() - options_.retain_seconds;
+      for (const std::string& job_id : store_.JobsFinishedBefore(cutoff)) {
+        try {
+          Delete(job_id);
+        } catch (const std::exception& e) {
+          spdlog::warn("job {}: past its retention but not deleted: {}", job_id, e.what());
+        }
       }
     }
     lock.lock();
+    try {
+      CollectUnusedScans();
+    } catch (const std::exception& e) {
+      spdlog::warn("unused scans not collected: {}", e.what());
+    }
   }
+}
+
+void JobManager::CollectUnusedScans() {
+  const auto cutoff = fs::file_time_type::clock::now() -
+                      std::chrono::duration_cast<fs::file_time_type::duration>(
+                          std::chrono::duration<double>(options_.scan_grace_seconds));
+  const std::vector<std::string> unused = data_dir_.ScansUnusedSince(cutoff);
+  if (unused.empty()) return;
+  const std::set<std::string> in_use = store_.ScansInUse();
+  uint64_t bytes = 0;
+  size_t count = 0;
+  for (const std::string& scan_id : unused) {
+    if (in_use.count(scan_id) != 0) continue;
+    store_.DeleteScan(scan_id);
+    bytes += data_dir_.RemoveScanFile(scan_id);
+    ++count;
+  }
+  if (count > 0) spdlog::info("{} scans no job uses deleted: {} bytes freed", count, bytes);
 }
 
 void JobManager::RemoveOrphanJobDirs() {
   const std::set<std::string> jobs = store_.JobIds();
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(data_dir_.JobsRoot(), ec)) {
-    const std::string name = entry.path().filename().string();
+  for (const std::string& name : data_dir_.JobDirNames()) {
     if (jobs.count(name) != 0) continue;
-    const uint64_t bytes = RemoveTree(entry.path().string());
-    spdlog::info("removed {} ({} bytes): no job has it (a deletion the last daemon did not finish)",
-                 entry.path().string(), bytes);
+    const uint64_t bytes = data_dir_.RemoveJobDir(name);
+    spdlog::info(
+        "removed jobs/{} ({} bytes): no job has it (a deletion the last daemon did not "
+        "finish)",
+        name, bytes);
   }
 }
 
@@ -229,6 +249,7 @@ bool JobManager::Drain(std::chrono::milliseconds timeout) {
       for (auto& [id, control] : running_) control->Interrupt();
     }
     queue_changed_.notify_all();
+    draining_started_.notify_all();
     const auto stopped = [this] { return running_.empty(); };
     if (timeout == std::chrono::milliseconds::max()) {
       job_ended_.wait(lock, stopped);
@@ -238,7 +259,7 @@ bool JobManager::Drain(std::chrono::milliseconds timeout) {
   }
   for (std::thread& slot : slots_) slot.join();
   slots_.clear();
-  if (retention_.joinable()) retention_.join();
+  if (housekeeping_.joinable()) housekeeping_.join();
   pool_.reset();  // every task has returned: each runner waited for its own
   return true;
 }
@@ -263,6 +284,7 @@ void JobManager::RunSlot() {
       spdlog::error("job {}: cannot read it from the data store: {}", job_id, e.what());
     }
     if (job) RunTracked(*job, *control);
+    data_dir_.RecountJobDir(job_id);
     std::lock_guard<std::mutex> lock(mutex_);
     running_.erase(job_id);
     job_ended_.notify_all();

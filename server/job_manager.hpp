@@ -34,6 +34,8 @@ struct ManagerOptions {
   uint64_t max_scan_points = 5000000;  // points per stored scan; more is RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;  // below it (or unwritable) new batches are FAILED_PRECONDITION
   double retain_seconds = 0.0;  // finished jobs older than this are deleted; 0 = kept for good
+  double scan_grace_seconds = 86400.0;  // scans no job uses go this long after their last use
+  uint64_t max_stored_bytes = 0;        // scans and outputs; 0 = no cap
 };
 
 class JobManager {
@@ -75,9 +77,13 @@ class JobManager {
  private:
   /// Removes folders under jobs/ that no stored job owns.
   void RemoveOrphanJobDirs();
-  /// Deletes the jobs that finished over options_.retain_seconds ago, now
-  /// and then until the manager drains.
-  void RunRetention();
+  /// Now and then until the manager drains: deletes the jobs that finished
+  /// over options_.retain_seconds ago, and collects unused scans.
+  void RunHousekeeping();
+  /// Deletes the scans no job uses that were last used over
+  /// options_.scan_grace_seconds ago. Call with mutex_ held, so that no
+  /// batch takes a scan meanwhile.
+  void CollectUnusedScans();
   void RunSlot();
   void RunTracked(const v1::Job& job, JobControl& control);
   void Publish(const v1::Job& job);
@@ -92,12 +98,13 @@ class JobManager {
   std::mutex mutex_;
   std::condition_variable queue_changed_;
   std::condition_variable job_ended_;
+  std::condition_variable draining_started_;  // wakes the housekeeping thread
   std::deque<std::string> queue_;
   std::map<std::string, std::shared_ptr<JobControl>> running_;
   bool accepting_ = false;
   bool draining_ = false;
   std::vector<std::thread> slots_;
-  std::thread retention_;
+  std::thread housekeeping_;
 };
 
 }  // namespace boicp::server

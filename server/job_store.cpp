@@ -200,6 +200,19 @@ std::set<std::string> JobStore::JobIds() {
   return ids;
 }
 
+std::set<std::string> JobStore::ScansInUse() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::set<std::string> ids;
+  auto stmt = db_.Prepare("SELECT metadata FROM job_scans");
+  while (stmt.Step()) ids.insert(Parse<v1::ScanMetadata>(stmt.ColumnBlob(0), "scan").sha256());
+  return ids;
+}
+
+void JobStore::DeleteScan(const std::string& scan_id) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  db_.Prepare("DELETE FROM scans WHERE scan_id = ?1").Bind(1, scan_id).Run();
+}
+
 std::vector<std::string> JobStore::JobsFinishedBefore(double cutoff) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> ids;

@@ -67,6 +67,10 @@ class JobStore {
   std::optional<v1::Job> DeleteFinishedJob(const std::string& job_id);
   /// Every job id the store holds.
   std::set<std::string> JobIds();
+  /// The ids of the scans some stored job uses.
+  std::set<std::string> ScansInUse();
+  /// Forgets a scan's metadata (its file is the DataDir's).
+  void DeleteScan(const std::string& scan_id);
   /// The final jobs whose finished_at (seconds since the epoch) is before `cutoff`.
   std::vector<std::string> JobsFinishedBefore(double cutoff);
   std::optional<JobInput> GetJobInput(const std::string& job_id);

@@ -67,7 +67,12 @@ grpc::ServerUnaryReactor* MapBuilderService::FindScans(grpc::CallbackServerConte
                          "scan_ids: at most " + std::to_string(kMaxFindScans) + " per call");
     }
     for (const std::string& id : request->scan_ids()) {
-      if (!deps_.store.GetScan(id) || !deps_.data_dir.HasScanFile(id)) response->add_missing(id);
+      if (!deps_.store.GetScan(id) || !deps_.data_dir.HasScanFile(id)) {
+        response->add_missing(id);
+      } else {
+        deps_.data_dir.TouchScan(
+            id);  // found for a batch: spared by the collection of unused scans
+      }
     }
     return grpc::Status::OK;
   });

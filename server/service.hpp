@@ -26,9 +26,10 @@ struct ServiceDeps {
   const BearerAuth& auth;
   UploadBudget& uploads;
   IdleUploads& idle_uploads;
-  uint64_t max_scan_bytes = 0;   // larger uploads are RESOURCE_EXHAUSTED
-  uint64_t max_scan_points = 0;  // scans decoding to more points are RESOURCE_EXHAUSTED
-  uint64_t min_free_bytes = 0;   // below it uploads and batches are FAILED_PRECONDITION
+  uint64_t max_scan_bytes = 0;    // larger uploads are RESOURCE_EXHAUSTED
+  uint64_t max_scan_points = 0;   // scans decoding to more points are RESOURCE_EXHAUSTED
+  uint64_t min_free_bytes = 0;    // below it uploads and batches are FAILED_PRECONDITION
+  uint64_t max_stored_bytes = 0;  // scans and outputs; more is RESOURCE_EXHAUSTED; 0 = no cap
 };
 
 /// The freshest view of a job: the newest published snapshot, else the store.

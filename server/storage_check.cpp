@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 
+#include "service_error.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {
@@ -60,6 +61,21 @@ std::optional<std::string> FindStorageProblem(const DataDir& dir, uint64_t reser
   return name + " is nearly full: " + Mebibytes(free_bytes) + " free" + upload +
          ", and boicpd keeps " + Mebibytes(reserve_bytes) + " free (--min-free-mb " +
          std::to_string(reserve_bytes >> 20) + ")";
+}
+
+void RequireStoredQuota(const DataDir& dir, uint64_t max_stored_bytes, uint64_t incoming_bytes) {
+  if (max_stored_bytes == 0) return;
+  const uint64_t stored = dir.StoredBytes();
+  if (stored + incoming_bytes <= max_stored_bytes) return;
+  char gigabytes[32];
+  std::snprintf(gigabytes, sizeof gigabytes, "%g", static_cast<double>(max_stored_bytes) / 1e9);
+  throw ServiceError(
+      grpc::StatusCode::RESOURCE_EXHAUSTED,
+      "stored scans and outputs take " + Mebibytes(stored) +
+          (incoming_bytes > 0 ? ", " + Mebibytes(incoming_bytes) + " more coming" : std::string()) +
+          ", over --max-stored-gb " + gigabytes +
+          "; delete finished jobs (boicp delete) to free room: the scans no job "
+          "uses go after --scan-grace-hours");
 }
 
 void RequireStorage(const DataDir& dir, uint64_t reserve_bytes, uint64_t incoming_bytes) {

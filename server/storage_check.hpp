@@ -23,4 +23,9 @@ std::optional<std::string> FindStorageProblem(const DataDir& dir, uint64_t reser
 /// Throws StorageError with FindStorageProblem's message when there is one.
 void RequireStorage(const DataDir& dir, uint64_t reserve_bytes, uint64_t incoming_bytes = 0);
 
+/// Throws ServiceError RESOURCE_EXHAUSTED when the stored scans and outputs
+/// plus `incoming_bytes` would pass `max_stored_bytes` (0: no cap), naming
+/// the flag and what frees room.
+void RequireStoredQuota(const DataDir& dir, uint64_t max_stored_bytes, uint64_t incoming_bytes = 0);
+
 }  // namespace boicp::server

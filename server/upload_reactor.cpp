@@ -142,6 +142,8 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
     // The other uploads in flight still have their announced bytes to write.
     RequireStorage(deps_.data_dir, deps_.min_free_bytes,
                    deps_.uploads.bytes_in_flight() + metadata.size_bytes());
+    RequireStoredQuota(deps_.data_dir, deps_.max_stored_bytes,
+                       deps_.uploads.bytes_in_flight() + metadata.size_bytes());
     ticket_.emplace(deps_.uploads, metadata.size_bytes());
     temp_path_ = deps_.data_dir.NewTempPath();
     temp_.open(temp_path_, std::ios::binary | std::ios::trunc);
@@ -157,6 +159,7 @@ bool UploadReactor::ReuseStoredCopy(const v1::ScanMetadata& metadata) {
   const std::optional<StoredScan> stored = deps_.store.GetScan(metadata.sha256());
   if (!stored || !deps_.data_dir.HasScanFile(metadata.sha256())) return false;
   RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight());
+  deps_.data_dir.TouchScan(metadata.sha256());
   ticket_.emplace(deps_.uploads, stored->metadata.size_bytes());
   return StoredCopyIntact(metadata.sha256());
 }
