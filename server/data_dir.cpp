@@ -124,12 +124,11 @@ std::string DataDir::JobDir(const std::string& job_id) const {
   return (fs::path(root_) / "jobs" / job_id).string();
 }
 
-std::string DataDir::JobsRoot() const { return (fs::path(root_) / "jobs").string(); }
-
 std::vector<std::string> DataDir::JobDirNames() const {
   std::vector<std::string> names;
   std::error_code ec;
-  for (fs::directory_iterator it(JobsRoot(), ec), end; !ec && it != end; it.increment(ec)) {
+  for (fs::directory_iterator it(fs::path(root_) / "jobs", ec), end; !ec && it != end;
+       it.increment(ec)) {
     names.push_back(it->path().filename().string());
   }
   return names;

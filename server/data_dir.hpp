@@ -34,8 +34,6 @@ class DataDir {
   /// False for an id that is not a scan id.
   bool HasScanFile(const std::string& scan_id) const;
   std::string JobDir(const std::string& job_id) const;
-  /// The folder of every job's folder (jobs/).
-  std::string JobsRoot() const;
   /// The job folders under jobs/, by name.
   std::vector<std::string> JobDirNames() const;
 

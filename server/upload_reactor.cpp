@@ -232,6 +232,8 @@ void UploadReactor::Complete() {
   if (!present) {
     deps_.data_dir.CommitScan(temp_path_, id);
     temp_path_.clear();
+  } else {
+    deps_.data_dir.TouchScan(id);  // uploaded again: its grace starts again
   }
   metadata.set_sha256(id);
   deps_.store.PutScan(metadata, cloud.points.size());
