@@ -69,6 +69,7 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
     spec.scans.push_back(std::move(source));
   }
 
+  spec.config = ConfigFromProto(request.config(), registration_threads);
   const v1::PairingPolicy& pairing = request.pairing();
   const std::vector<PairIndex> listed = PairsFromProto(pairing);
   switch (pairing.mode()) {
@@ -89,9 +90,7 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
         throw InputError("pairing.overlap_threshold must be in (0, 1] (0 = default)");
       }
       spec.overlap_threshold =
-          threshold != 0.0
-              ? threshold
-              : BatchOverlapThreshold(spec.scans, ParseSensorSetting(request.config().sensor()));
+          threshold != 0.0 ? threshold : BatchOverlapThreshold(spec.scans, spec.config.sensor);
       spec.extra_pairs = listed;
       ValidatePairs(n, listed, /*require_connected=*/false);
       break;
@@ -105,7 +104,6 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
     default:
       throw InputError("pairing.mode: unknown mode " + std::to_string(pairing.mode()));
   }
-  spec.config = ConfigFromProto(request.config(), registration_threads);
   spec.map = MapSettingsFromProto(request.map());
   spec.map_auto =
       settings::MapAutoFromSettings(rpc::SettingsFromProto(request.config(), request.map()));

@@ -47,13 +47,14 @@ std::ifstream OpenOrThrow(const std::string& path, std::ios::openmode mode) {
 
 std::vector<std::string_view> SplitFields(std::string_view line) {
   std::vector<std::string_view> fields;
-  size_t pos = line.find_first_not_of(kFieldSeparators);
-  while (pos != std::string_view::npos) {
-    const size_t end = line.find_first_of(kFieldSeparators, pos);
-    fields.push_back(line.substr(pos, end == std::string_view::npos ? end : end - pos));
-    pos = end == std::string_view::npos ? end : line.find_first_not_of(kFieldSeparators, end);
+  size_t pos = 0;
+  while (true) {
+    while (pos < line.size() && IsFieldSeparator(line[pos])) ++pos;
+    if (pos == line.size()) return fields;
+    const size_t start = pos;
+    while (pos < line.size() && !IsFieldSeparator(line[pos])) ++pos;
+    fields.push_back(line.substr(start, pos - start));
   }
-  return fields;
 }
 
 std::optional<double> ParseNumber(std::string_view token) {

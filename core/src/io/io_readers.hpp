@@ -22,15 +22,12 @@ void RequireReadableFile(const std::string& path);
 std::ifstream OpenOrThrow(const std::string& path, std::ios::openmode mode = std::ios::in);
 
 /// What separates the fields of a text line: runs of spaces, tabs, commas or
-/// carriage returns (files written on Windows keep their '\r').
-inline constexpr std::string_view kFieldSeparators = " \t,\r";
-
-/// One of kFieldSeparators, spelled out for the per-character loops of large
-/// files, where a search of that string per character costs more than the
-/// number parsing.
+/// carriage returns (files written on Windows keep their '\r'). Tested a
+/// character at a time: a search of a separator string per character costs
+/// more than the number parsing of a large file.
 inline bool IsFieldSeparator(char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r'; }
 
-/// Splits a text line into its fields (kFieldSeparators).
+/// Splits a text line into its fields (IsFieldSeparator).
 std::vector<std::string_view> SplitFields(std::string_view line);
 
 /// Parses a whole token as a double, independent of the C locale. Accepts a

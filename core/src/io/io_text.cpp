@@ -23,7 +23,7 @@ std::string Quoted(const std::string& line) {
   return "'" + line.substr(0, kQuotedLineLimit) + "...'";
 }
 
-// Reads x y z from the first three fields (kFieldSeparators); later columns
+// Reads x y z from the first three fields (IsFieldSeparator); later columns
 // (intensity, colour, labels) may hold anything and are ignored. Allocates
 // nothing unless the line is bad, and tests each character once: a scan has
 // hundreds of thousands of lines.
