@@ -156,6 +156,13 @@ void ChooseRunSettings(LocalRun& run) {
   ValidateOccupancySettings(run.map.occupancy);
 }
 
+void ApplyResourceLimits(LocalRun& run, const std::vector<RangeProfile>& profiles,
+                         uint64_t max_fusion_mb) {
+  RequireVoxelsFitExtent(run.config, ProfilesExtent(profiles));
+  run.map.max_fusion_bytes = static_cast<size_t>(max_fusion_mb << 20);
+  RequireFusionWithinLimit(run.folder.scans, profiles, run.map.occupancy, run.map.max_fusion_bytes);
+}
+
 void PrintRunSettings(const LocalRun& run) {
   std::fprintf(
       stderr,

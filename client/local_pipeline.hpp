@@ -14,6 +14,7 @@
 
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/settings/requested_settings.hpp"
 #include "local_pairs.hpp"
 
@@ -61,6 +62,14 @@ LocalRun PrepareRun(const MapSettings& settings);
 /// Chooses the settings the user left automatic from the run's scans
 /// (ApplyBatchSettings), once for the whole run.
 void ChooseRunSettings(LocalRun& run);
+
+/// Checks the run's chosen settings against its scans and sets its fusion
+/// memory limit to `max_fusion_mb` MiB (0 = none): throws InputError for a
+/// voxel too fine for the scans' extent (RequireVoxelsFitExtent) and
+/// LimitExceeded for a map estimated over the limit. `profiles` are the
+/// run's scans' ProfileScans.
+void ApplyResourceLimits(LocalRun& run, const std::vector<RangeProfile>& profiles,
+                         uint64_t max_fusion_mb);
 
 /// One "settings: ..." line on stderr: the values used and which were chosen.
 void PrintRunSettings(const LocalRun& run);

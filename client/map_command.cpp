@@ -24,6 +24,7 @@ struct MapFlags {
   std::string out_dir;
   std::string shard;  // "K/N"; empty = the whole run
   int threads = AvailableCores();
+  uint64_t max_fusion_mb = 0;
   bool json = false;
 };
 
@@ -141,8 +142,10 @@ int RunMap(MapFlags flags) {
           "consecutive or explicit pairing");
     }
     if (sharded) CheckShardManifest(run, out);
-    CheckScansLoad(run.folder, flags.threads);
+    const std::vector<RangeProfile> profiles = ProfileScans(run.folder.scans, flags.threads);
     ChooseRunSettings(run);
+    // Shards fuse nothing, but their merge would refuse what this refuses.
+    ApplyResourceLimits(run, profiles, flags.max_fusion_mb);
     run.map.fusion_threads = flags.threads;
     std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
     PrintRunSettings(run);
@@ -150,6 +153,9 @@ int RunMap(MapFlags flags) {
     ClaimShardManifest(run, out);
     return RunShard(run, shard, flags);
   } catch (const InputError& e) {
+    std::cerr << "boicp map: error: " << e.what() << std::endl;
+    return kBadInput;
+  } catch (const LimitExceeded& e) {  // settings the scans do not fit
     std::cerr << "boicp map: error: " << e.what() << std::endl;
     return kBadInput;
   } catch (const std::exception& e) {
@@ -171,6 +177,7 @@ CommandRunner AddMapCommand(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--shard", f.shard,
                  "K/N: register only pairs K-1 mod N into OUTDIR/pairs, no map (then merge)");
+  AddFusionLimitFlag(app, f.max_fusion_mb);
   app.add_flag("--json", f.json, "Print a JSON summary on stdout");
   return [flags] { return RunMap(*flags); };
 }

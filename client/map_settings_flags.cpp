@@ -1,6 +1,17 @@
 #include "map_settings_flags.hpp"
 
+#include "boicp/util/system_memory.hpp"
+
 namespace boicp::cli {
+
+void AddFusionLimitFlag(CLI::App& app, uint64_t& max_fusion_mb) {
+  max_fusion_mb = DefaultFusionLimitMb();
+  app.add_option("--max-fusion-mb", max_fusion_mb,
+                 "MiB the map's fusion may hold (default: half the memory of this machine or "
+                 "container); a map estimated over it is refused before any pair is "
+                 "registered, and one that grows past it stops (0 = no limit)")
+      ->capture_default_str();
+}
 
 void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Frontend frontend) {
   MapSettings& s = flags.settings;

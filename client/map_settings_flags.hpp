@@ -3,6 +3,7 @@
 // read it, the BO-ICP preset and its overrides, the pairing and the map
 // settings. One registration, so both commands spell and default them alike.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct MapSettingsFlags {
 /// schema gives `frontend` (kMap or kSubmit).
 void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags,
                          settings::Frontend frontend = settings::kMap);
+
+/// Adds --max-fusion-mb for the commands that fuse a map locally, its value
+/// defaulting to DefaultFusionLimitMb().
+void AddFusionLimitFlag(CLI::App& app, uint64_t& max_fusion_mb);
 
 /// The settings with --pairing's words split into mode, FILE and PATH.
 /// Throws InputError for a stray word, a missing PATH or a malformed value.

@@ -10,6 +10,7 @@
 #include "boicp/util/parallel_for.hpp"
 #include "commands.hpp"
 #include "local_map.hpp"
+#include "map_settings_flags.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -20,6 +21,7 @@ using nlohmann::json;
 struct MergeFlags {
   std::vector<std::string> shard_dirs;
   std::string out_dir;
+  uint64_t max_fusion_mb = 0;
   bool json = false;
 };
 
@@ -46,7 +48,7 @@ int RunMerge(const MergeFlags& flags) {
     ChooseRunSettings(run);  // the shards' own choice: the same scans give the same settings
     const std::map<PairIndex, PairRecord> records =
         ReadStoredPairs(run, run.plan, flags.shard_dirs);
-    CheckScansLoad(run.folder, AvailableCores());
+    ApplyResourceLimits(run, ProfileScans(run.folder.scans, AvailableCores()), flags.max_fusion_mb);
     std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(),
                  run.folder.description.c_str(), records.size());
     PrintRunSettings(run);
@@ -68,6 +70,9 @@ int RunMerge(const MergeFlags& flags) {
   } catch (const InputError& e) {
     std::cerr << "boicp merge: error: " << e.what() << std::endl;
     return kBadInput;
+  } catch (const LimitExceeded& e) {  // settings the scans do not fit
+    std::cerr << "boicp merge: error: " << e.what() << std::endl;
+    return kBadInput;
   } catch (const std::exception& e) {
     std::cerr << "boicp merge: error: " << e.what() << std::endl;
     return kFailure;
@@ -82,6 +87,7 @@ CommandRunner AddMergeCommand(CLI::App& app) {
                  "Output folder(s) of the shards (each with run.json and pairs/)")
       ->required();
   app.add_option("-o,--out", flags->out_dir, "Output folder (may be the shards' own)")->required();
+  AddFusionLimitFlag(app, flags->max_fusion_mb);
   app.add_flag("--json", flags->json, "Print a JSON summary on stdout");
   return [flags] { return RunMerge(*flags); };
 }

@@ -54,6 +54,8 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_options.retain_seconds = options_.retain_days * 86400.0;
   manager_options.scan_grace_seconds = options_.scan_grace_hours * 3600.0;
   manager_options.max_stored_bytes = max_stored_bytes;
+  manager_options.max_fusion_bytes = static_cast<size_t>(options_.max_fusion_mb << 20);
+  manager_options.max_job_seconds = options_.max_job_seconds;
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
                                             options_.max_upload_bytes_in_flight);
@@ -88,9 +90,10 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
                data_dir_->root());
   spdlog::info(
       "limits: {} queued jobs, {} scans a batch, {} bytes a message, {} bytes and {} "
-      "points a scan; {} MiB kept free",
+      "points a scan; {} MiB kept free; {} MiB of fusion and {} s a job (0 = no limit)",
       options_.max_queued_jobs, options_.max_batch_scans, options_.max_message_bytes,
-      options_.max_scan_bytes, options_.max_scan_points, options_.min_free_mb);
+      options_.max_scan_bytes, options_.max_scan_points, options_.min_free_mb,
+      options_.max_fusion_mb, options_.max_job_seconds);
   spdlog::info("auth {}, TLS {}", auth_.enabled() ? "on" : "off",
                options_.tls_cert.empty()        ? "off"
                : options_.tls_client_ca.empty() ? "on"

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "boicp/util/parallel_for.hpp"
+#include "boicp/util/system_memory.hpp"
 
 namespace boicp::server {
 
@@ -46,6 +47,17 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "Most points one scan may decode to (checked at upload and submission)")
       ->capture_default_str()
       ->envname("BOICPD_MAX_SCAN_POINTS");
+  o.max_fusion_mb = DefaultFusionLimitMb();
+  app.add_option("--max-fusion-mb", o.max_fusion_mb,
+                 "MiB one job's map fusion may hold (default: half the memory of the machine or "
+                 "container); a batch estimated over it is RESOURCE_EXHAUSTED, and a job that "
+                 "passes it fails (0 = no limit)")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_FUSION_MB");
+  app.add_option("--max-job-seconds", o.max_job_seconds,
+                 "Seconds a job may run before it fails (0 = no deadline)")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_JOB_SECONDS");
   app.add_option("--min-free-mb", o.min_free_mb,
                  "MiB kept free in the data directory: below it boicpd does not start and "
                  "refuses new scans and batches (0 = only a full disk)")
@@ -134,6 +146,9 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.scan_grace_hours >= 0.0 && o.scan_grace_hours <= 1e6,
           "--scan-grace-hours must be in 0..1000000");
   require(o.max_stored_gb >= 0.0 && o.max_stored_gb <= 1e7, "--max-stored-gb must be in 0..1e7");
+  require(o.max_fusion_mb <= (uint64_t{1} << 40), "--max-fusion-mb must be at most 2^40");
+  require(o.max_job_seconds >= 0.0 && o.max_job_seconds <= 1e9,
+          "--max-job-seconds must be in 0..1e9");
   require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");
   require(o.tls_client_ca.empty() || !o.tls_cert.empty(), "--tls-client-ca needs --tls-cert");
   require(o.max_concurrent_uploads >= 1 && o.max_concurrent_uploads <= 10000,

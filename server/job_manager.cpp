@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "job_spec.hpp"
 #include "log_text.hpp"
@@ -25,8 +26,9 @@ JobManager::JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
                        const ManagerOptions& options)
     : store_(store), data_dir_(data_dir), events_(events), options_(options) {
   pool_ = std::make_unique<ThreadPool>(options_.workers);
-  context_ = std::make_unique<RunnerContext>(RunnerContext{
-      store_, data_dir_, *pool_, events_, options_.registration_threads, options_.workers});
+  context_ = std::make_unique<RunnerContext>(
+      RunnerContext{store_, data_dir_, *pool_, events_, options_.registration_threads,
+                    options_.workers, options_.max_fusion_bytes, options_.max_job_seconds});
 }
 
 JobManager::~JobManager() { Drain(); }
@@ -80,6 +82,7 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   }
   JobInput input;
   input.request = request;
+  std::vector<RangeProfile> profiles;
   for (int i = 0; i < request.scan_ids_size(); ++i) {
     const std::optional<StoredScan> scan = store_.GetScan(request.scan_ids(i));
     if (!scan || !data_dir_.HasScanFile(request.scan_ids(i))) {
@@ -95,9 +98,15 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
                              std::to_string(options_.max_scan_points) + " (--max-scan-points)");
     }
     input.scans.push_back(scan->metadata);
+    profiles.push_back(scan->ranges);
   }
   const JobSpec spec =
       BuildJobSpec("new", request, input.scans, data_dir_, options_.registration_threads);
+  RequireVoxelsFitExtent(spec.config, ProfilesExtent(profiles));
+  // Map settings chosen from the scans are checked when the job starts.
+  if (!spec.map_auto.resolution && !spec.map_auto.max_range) {
+    RequireFusionWithinLimit(spec.scans, profiles, spec.map.occupancy, options_.max_fusion_bytes);
+  }
   RequireStorage(data_dir_, options_.min_free_bytes);
 
   std::lock_guard<std::mutex> lock(mutex_);

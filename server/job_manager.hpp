@@ -36,6 +36,8 @@ struct ManagerOptions {
   double retain_seconds = 0.0;  // finished jobs older than this are deleted; 0 = kept for good
   double scan_grace_seconds = 86400.0;  // scans no job uses go this long after their last use
   uint64_t max_stored_bytes = 0;        // scans and outputs; 0 = no cap
+  size_t max_fusion_bytes = 0;          // one job's fusion memory; 0 = no limit
+  double max_job_seconds = 0.0;         // a running job fails past it; 0 = no deadline
 };
 
 class JobManager {
@@ -53,8 +55,9 @@ class JobManager {
 
   /// Validates and queues a batch; returns the queued job. Throws
   /// InputError (bad batch), ServiceError RESOURCE_EXHAUSTED (limits) or
-  /// UNAVAILABLE (draining), StorageError (data directory unwritable or
-  /// below its reserve).
+  /// UNAVAILABLE (draining), LimitExceeded (a map estimated over the fusion
+  /// memory limit), StorageError (data directory unwritable or below its
+  /// reserve).
   v1::Job Submit(const v1::SubmitBatchRequest& request);
 
   /// Cancels a queued job at once, asks a running one to stop (its state

@@ -4,10 +4,12 @@
 #include <chrono>
 #include <optional>
 #include <set>
+#include <sstream>
 
 #include <spdlog/spdlog.h>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/mapping/map_pipeline.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "job_outputs.hpp"
@@ -20,6 +22,12 @@ namespace boicp::server {
 void JobControl::Cancel() { cancelled_ = true; }
 
 void JobControl::Interrupt() { interrupted_ = true; }
+
+void JobControl::SetDeadline(std::chrono::steady_clock::time_point deadline) {
+  deadline_ = deadline;
+}
+
+bool JobControl::past_deadline() const { return std::chrono::steady_clock::now() > deadline_; }
 
 namespace {
 
@@ -106,11 +114,31 @@ class JobRun : public MapProgressSink {
     // Fusion starts once this job's pairs are done; its ray casting takes one
     // thread per worker (the map does not depend on the count).
     batch_.map.fusion_threads = ctx_.pool.size();
+    batch_.map.max_fusion_bytes = ctx_.max_fusion_bytes;
+    RequireFusionWithinLimit(batch_.scans, ScanProfiles(), batch_.map.occupancy,
+                             ctx_.max_fusion_bytes);
     batch_.plan = JobPlan(batch_spec_);
     job_.set_state(v1::JOB_STATE_RUNNING);
     if (job_.started_at() == 0.0) job_.set_started_at(rpc::NowSeconds());
+    if (ctx_.max_job_seconds > 0.0) {
+      // From the job's first start: a resumed job does not begin again.
+      const double left = ctx_.max_job_seconds - (rpc::NowSeconds() - job_.started_at());
+      control_.SetDeadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                              std::chrono::duration<double>(std::max(left, 0.0))));
+    }
     job_.set_stage("registering");
     job_.set_eta_seconds(-1.0);
+  }
+
+  // Each scan's range profile as stored at upload (empty for scans stored
+  // before profiles were).
+  std::vector<RangeProfile> ScanProfiles() const {
+    std::vector<RangeProfile> profiles;
+    for (const std::string& scan_id : batch_spec_.scan_ids) {
+      const std::optional<StoredScan> scan = ctx_.store.GetScan(scan_id);
+      profiles.push_back(scan ? scan->ranges : RangeProfile{});
+    }
+    return profiles;
   }
 
   // A scan whose bytes no longer match its name fails the job (the error
@@ -252,6 +280,12 @@ class JobRun : public MapProgressSink {
 
   RunOutcome EndAfterStop() {
     if (control_.cancelled()) return End(v1::JOB_STATE_CANCELLED, "");
+    if (control_.past_deadline()) {
+      std::ostringstream error;
+      error << "the job ran longer than this daemon's limit of " << ctx_.max_job_seconds
+            << " s (--max-job-seconds)";
+      return End(v1::JOB_STATE_FAILED, error.str());
+    }
     spdlog::info("job {} interrupted by shutdown after {} of {} pairs; it resumes on restart",
                  job_.job_id(), job_.pairs_done(), job_.pairs_total());
     return RunOutcome::kInterrupted;

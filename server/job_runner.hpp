@@ -6,6 +6,8 @@
 // unfinished pairs.
 
 #include <atomic>
+#include <chrono>
+#include <cstddef>
 
 #include "boicp/util/thread_pool.hpp"
 #include "boicp/v1/map_builder.pb.h"
@@ -21,7 +23,9 @@ struct RunnerContext {
   ThreadPool& pool;
   JobEventSink& events;
   int registration_threads = 1;
-  int max_pairs_in_flight = 1;  // per job, so concurrent jobs share the pool
+  int max_pairs_in_flight = 1;   // per job, so concurrent jobs share the pool
+  size_t max_fusion_bytes = 0;   // one job's fusion memory; 0 = no limit
+  double max_job_seconds = 0.0;  // from the job's first start; 0 = no deadline
 };
 
 /// Stop requests for a running job, shared by the manager, the runner and
@@ -33,13 +37,18 @@ class JobControl {
   void Cancel();
   /// The daemon drains: the job stops but stays resumable.
   void Interrupt();
+  /// The job stops, to fail, once the steady clock passes `deadline`. Set
+  /// before the job's tasks start.
+  void SetDeadline(std::chrono::steady_clock::time_point deadline);
   bool cancelled() const { return cancelled_; }
   bool interrupted() const { return interrupted_; }
-  bool StopRequested() const { return cancelled_ || interrupted_; }
+  bool past_deadline() const;
+  bool StopRequested() const { return cancelled_ || interrupted_ || past_deadline(); }
 
  private:
   std::atomic<bool> cancelled_{false};
   std::atomic<bool> interrupted_{false};
+  std::chrono::steady_clock::time_point deadline_ = std::chrono::steady_clock::time_point::max();
 };
 
 enum class RunOutcome { kSucceeded, kFailed, kCancelled, kInterrupted };

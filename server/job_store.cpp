@@ -75,6 +75,40 @@ InformationMatrix InformationFromBytes(const std::string& bytes) {
   return information;
 }
 
+// A range profile as bytes: its bin count, its three count arrays and the
+// farthest range, in native byte order like the information matrices.
+std::string RangeProfileBytes(const RangeProfile& profile) {
+  if (profile.empty()) return {};
+  const uint32_t bins = static_cast<uint32_t>(profile.counts.size());
+  std::string bytes(reinterpret_cast<const char*>(&bins), sizeof(bins));
+  for (const std::vector<uint32_t>* counts :
+       {&profile.counts, &profile.ray_counts, &profile.direction_counts}) {
+    bytes.append(reinterpret_cast<const char*>(counts->data()), bins * sizeof(uint32_t));
+  }
+  bytes.append(reinterpret_cast<const char*>(&profile.max_range), sizeof(double));
+  return bytes;
+}
+
+// An empty profile for bytes that do not hold one (scans stored before
+// profiles were).
+RangeProfile RangeProfileFromBytes(const std::string& bytes) {
+  uint32_t bins = 0;
+  if (bytes.size() < sizeof(bins)) return {};
+  std::memcpy(&bins, bytes.data(), sizeof(bins));
+  const size_t array_bytes = size_t{bins} * sizeof(uint32_t);
+  if (bins == 0 || bytes.size() != sizeof(bins) + 3 * array_bytes + sizeof(double)) return {};
+  RangeProfile profile;
+  const char* in = bytes.data() + sizeof(bins);
+  for (std::vector<uint32_t>* counts :
+       {&profile.counts, &profile.ray_counts, &profile.direction_counts}) {
+    counts->resize(bins);
+    std::memcpy(counts->data(), in, array_bytes);
+    in += array_bytes;
+  }
+  std::memcpy(&profile.max_range, in, sizeof(double));
+  return profile;
+}
+
 std::string JobIdForSeq(int64_t seq) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "job-%06lld", static_cast<long long>(seq));
@@ -91,10 +125,11 @@ JobStore::JobStore(const std::string& path) : db_(path) {
   db_.Exec("PRAGMA foreign_keys=ON");
   db_.Exec(kSchema);
   // Columns added since the first release; older rows read their defaults:
-  // no unended runs, and answered by the full search, as every pair was
-  // before the escalation ladder.
+  // no unended runs, answered by the full search, as every pair was before
+  // the escalation ladder, and no range profile.
   AddMissingColumn("jobs", "unended_runs", "INTEGER NOT NULL DEFAULT 0");
   AddMissingColumn("pair_results", "answered_by", "TEXT NOT NULL DEFAULT 'full-search'");
+  AddMissingColumn("scans", "range_profile", "BLOB NOT NULL DEFAULT x''");
 }
 
 void JobStore::AddMissingColumn(const std::string& table, const std::string& column,
@@ -131,25 +166,30 @@ int JobStore::ReadUnendedRuns(const std::string& job_id) {
   return stmt.Step() ? static_cast<int>(stmt.ColumnInt(0)) : 0;
 }
 
-void JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points) {
+void JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points,
+                       const RangeProfile& ranges) {
   std::lock_guard<std::mutex> lock(mutex_);
   db_.Prepare(
-         "INSERT INTO scans (scan_id, num_points, metadata) VALUES (?1, ?2, ?3) "
-         "ON CONFLICT (scan_id) DO UPDATE SET num_points = ?2, metadata = ?3")
+         "INSERT INTO scans (scan_id, num_points, metadata, range_profile) "
+         "VALUES (?1, ?2, ?3, ?4) "
+         "ON CONFLICT (scan_id) DO UPDATE SET num_points = ?2, metadata = ?3, range_profile = ?4")
       .Bind(1, metadata.sha256())
       .Bind(2, static_cast<int64_t>(num_points))
       .BindBlob(3, Serialize(metadata))
+      .BindBlob(4, RangeProfileBytes(ranges))
       .Run();
 }
 
 std::optional<StoredScan> JobStore::GetScan(const std::string& scan_id) {
   std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare("SELECT num_points, metadata FROM scans WHERE scan_id = ?1");
+  auto stmt =
+      db_.Prepare("SELECT num_points, metadata, range_profile FROM scans WHERE scan_id = ?1");
   stmt.Bind(1, scan_id);
   if (!stmt.Step()) return std::nullopt;
   StoredScan scan;
   scan.num_points = static_cast<uint64_t>(stmt.ColumnInt(0));
   scan.metadata = Parse<v1::ScanMetadata>(stmt.ColumnBlob(1), "scan");
+  scan.ranges = RangeProfileFromBytes(stmt.ColumnBlob(2));
   return scan;
 }
 

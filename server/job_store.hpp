@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/mapping/pose_graph.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "sqlite_db.hpp"
@@ -24,6 +25,7 @@ namespace v1 = ::boicp::v1;
 struct StoredScan {
   v1::ScanMetadata metadata;  // sha256 holds the scan id
   uint64_t num_points = 0;
+  RangeProfile ranges;  // empty for scans stored before profiles were
 };
 
 /// What a job needs to run, as accepted at submission.
@@ -47,7 +49,7 @@ class JobStore {
   /// Opens or creates the database and its schema. Throws std::runtime_error.
   explicit JobStore(const std::string& path);
 
-  void PutScan(const v1::ScanMetadata& metadata, uint64_t num_points);
+  void PutScan(const v1::ScanMetadata& metadata, uint64_t num_points, const RangeProfile& ranges);
   std::optional<StoredScan> GetScan(const std::string& scan_id);
 
   /// Assigns the job id ("job-000001", ...) and stores the job and its

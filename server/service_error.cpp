@@ -14,6 +14,8 @@ grpc::Status StatusFromCurrentException(const char* rpc) {
     return grpc::Status(e.code(), e.what());
   } catch (const InputError& e) {
     return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const LimitExceeded& e) {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e.what());
   } catch (const StorageError& e) {
     spdlog::warn("{}: refused: {}", rpc, e.what());
     return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION, e.what());

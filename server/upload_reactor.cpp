@@ -7,6 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "scan_integrity.hpp"
 #include "service.hpp"
@@ -194,17 +195,20 @@ void UploadReactor::Complete() {
   v1::ScanMetadata metadata = *metadata_;
   if (known_) {
     // The new metadata must still describe the stored bytes: a format or
-    // camera change re-parses them; the same decoding keeps the stored count.
+    // camera change re-parses them (as does a scan stored without a range
+    // profile); the same decoding keeps the stored count and profile.
     const StoredScan stored = *deps_.store.GetScan(metadata.sha256());
     uint64_t points = stored.num_points;
-    if (!SameDecoding(metadata, stored.metadata)) {
-      points = LoadUploadedScan(deps_.data_dir.ScanPath(metadata.sha256()), metadata,
-                                deps_.max_scan_points)
-                   .points.size();
+    RangeProfile ranges = stored.ranges;
+    if (!SameDecoding(metadata, stored.metadata) || ranges.empty()) {
+      const LoadedCloud cloud = LoadUploadedScan(deps_.data_dir.ScanPath(metadata.sha256()),
+                                                 metadata, deps_.max_scan_points);
+      points = cloud.points.size();
+      ranges = ProfileRanges(cloud.points);
     }
     RequirePointLimit(points, deps_.max_scan_points);
     metadata.set_size_bytes(stored.metadata.size_bytes());
-    deps_.store.PutScan(metadata, points);
+    deps_.store.PutScan(metadata, points, ranges);
     response_->set_scan_id(metadata.sha256());
     response_->set_already_present(true);
     response_->set_num_points(points);
@@ -236,7 +240,7 @@ void UploadReactor::Complete() {
     deps_.data_dir.TouchScan(id);  // uploaded again: its grace starts again
   }
   metadata.set_sha256(id);
-  deps_.store.PutScan(metadata, cloud.points.size());
+  deps_.store.PutScan(metadata, cloud.points.size(), ProfileRanges(cloud.points));
   response_->set_scan_id(id);
   response_->set_already_present(present);
   response_->set_num_points(cloud.points.size());

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 namespace boicp {
 
@@ -85,6 +86,19 @@ PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config) {
   PoseGraphOptions options;
   options.max_correspondence_distance = job_config.EffectiveInlierDistance();
   return options;
+}
+
+void RequireVoxelsFitExtent(const BoIcpConfig& config, double extent) {
+  const double floor = kMinVoxelOfExtent * extent;
+  const auto require = [&](const char* field, double voxel) {
+    if (voxel >= floor) return;
+    std::ostringstream message;
+    message << field << ": " << voxel << " m is finer than " << kMinVoxelOfExtent
+            << " of the scans' extent (" << extent << " m); use at least " << floor << " m";
+    throw InputError(message.str());
+  };
+  require("voxel", config.voxel);
+  require("refine_voxel", config.EffectiveRefineVoxel());
 }
 
 }  // namespace boicp

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <sstream>
 #include <utility>
 
 #include "boicp/io/trajectory_io.hpp"
@@ -44,14 +45,24 @@ struct PreparedScan {
 
 PreparedScan PrepareScan(const OccupancyMap& map, const ScanSource& scan, const Transform& pose,
                          const MapBuildSettings& settings, bool want_cloud, int threads,
-                         const MapStopRequest& stop) {
+                         size_t max_update_bytes, const MapStopRequest& stop) {
   PreparedScan prepared;
   Points points = LoadPointCloud(scan.path, scan.load).points;
-  prepared.update = map.ComputeUpdate(points, pose, scan.sensor_origin, threads, stop);
+  prepared.update =
+      map.ComputeUpdate(points, pose, scan.sensor_origin, threads, stop, max_update_bytes);
   if (want_cloud) {
     prepared.cloud_points = WithinRange(points, scan.sensor_origin, settings.occupancy.max_range);
   }
   return prepared;
+}
+
+// What passed the fusion memory limit, and what to change.
+LimitExceeded FusionLimitError(const LimitExceeded& e, const MapBuildSettings& settings) {
+  std::ostringstream message;
+  message << "fusion needs more memory than its limit of " << (settings.max_fusion_bytes >> 20)
+          << " MB (--max-fusion-mb): " << e.what() << " at " << settings.occupancy.resolution
+          << " m leaves; coarsen the map resolution, shorten max_range or raise the limit";
+  return LimitExceeded(message.str());
 }
 
 void WriteText(const std::string& path, const std::function<void(std::ostream&)>& write) {
@@ -106,7 +117,14 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
     throw InputError("map assembly: " + std::to_string(poses.size()) + " poses for " +
                      std::to_string(scans.size()) + " scans");
   }
-  OccupancyMap map(settings.occupancy);
+  // The tree takes most: a scan's cells are a small bitmap next to the tree
+  // nodes they make. A quarter of the limit is shared by the scans in
+  // flight: a window being applied and one being cast, each scan's cells
+  // cast and then merged (twice its cap at most).
+  const int threads = std::max(settings.fusion_threads, 1);
+  const int window = std::min(threads, kFusionWindow);
+  const size_t max_update_bytes = settings.max_fusion_bytes / (12 * static_cast<size_t>(window));
+  OccupancyMap map(settings.occupancy, settings.max_fusion_bytes / 4 * 3);
   const double cloud_voxel =
       settings.cloud_voxel > 0.0 ? settings.cloud_voxel : settings.occupancy.resolution;
   VoxelAccumulator cloud(cloud_voxel);
@@ -122,39 +140,41 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   // count, never the tree. A stop request ends the ray casting, the tree
   // update and the tree writes from inside, so a large scan or map does not
   // hold a cancel or a drain back.
-  const int threads = std::max(settings.fusion_threads, 1);
-  const int window = std::min(threads, kFusionWindow);
   const int ray_threads = std::max(threads / window, 1);
   const auto window_at = [&](int first) { return std::max(std::min(window, total - first), 0); };
   const auto prepare = [&](int i) {
     const auto index = static_cast<size_t>(i);
     return PrepareScan(map, scans[index], poses[index], settings, want_cloud, ray_threads,
-                       callbacks.stop_requested);
+                       max_update_bytes, callbacks.stop_requested);
   };
-  std::vector<PreparedScan> current(static_cast<size_t>(window_at(0)));
-  ThrowIfStopped(callbacks);
-  ParallelFor(current.size(), threads,
-              [&](size_t k) { current[k] = prepare(static_cast<int>(k)); });
-  for (int first = 0; first < total; first += window) {
+  try {
+    std::vector<PreparedScan> current(static_cast<size_t>(window_at(0)));
     ThrowIfStopped(callbacks);
-    const int next_first = first + window;
-    std::vector<PreparedScan> next(static_cast<size_t>(window_at(next_first)));
-    ParallelFor(1 + next.size(), threads, [&](size_t task) {
-      if (task > 0) {
-        next[task - 1] = prepare(next_first + static_cast<int>(task) - 1);
-        return;
-      }
-      for (size_t k = 0; k < current.size(); ++k) {
-        map.ApplyUpdate(current[k].update, callbacks.stop_requested);
-        if (want_cloud) {
-          cloud.Add(current[k].cloud_points, poses[static_cast<size_t>(first) + k]);
+    ParallelFor(current.size(), threads,
+                [&](size_t k) { current[k] = prepare(static_cast<int>(k)); });
+    for (int first = 0; first < total; first += window) {
+      ThrowIfStopped(callbacks);
+      const int next_first = first + window;
+      std::vector<PreparedScan> next(static_cast<size_t>(window_at(next_first)));
+      ParallelFor(1 + next.size(), threads, [&](size_t task) {
+        if (task > 0) {
+          next[task - 1] = prepare(next_first + static_cast<int>(task) - 1);
+          return;
         }
+        for (size_t k = 0; k < current.size(); ++k) {
+          map.ApplyUpdate(current[k].update, callbacks.stop_requested);
+          if (want_cloud) {
+            cloud.Add(current[k].cloud_points, poses[static_cast<size_t>(first) + k]);
+          }
+        }
+      });
+      for (size_t k = 1; k <= current.size(); ++k) {
+        Report(callbacks, "fusing", first + static_cast<int>(k), total);
       }
-    });
-    for (size_t k = 1; k <= current.size(); ++k) {
-      Report(callbacks, "fusing", first + static_cast<int>(k), total);
+      current = std::move(next);
     }
-    current = std::move(next);
+  } catch (const LimitExceeded& e) {
+    throw FusionLimitError(e, settings);
   }
 
   ThrowIfStopped(callbacks);

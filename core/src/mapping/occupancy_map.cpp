@@ -32,11 +32,21 @@ void RequireValidMapSettings(bool ok, const std::string& message) {
 constexpr size_t kRaysPerStopPoll = 64;
 constexpr size_t kCellsPerStopPoll = 16384;
 
-// A stop request shared by the threads of one ray cast: the first to see it
-// fired tells the others, which then return at their next poll.
+// Heap bytes per element, allocator overhead included: a bitmap block and
+// its hash-map node, an occupied key's hash-set node, and a tree node with
+// its share of a parent's eight child pointers (a leaf of a sparse tree may
+// be the only child of every parent up the path; the tree rarely is).
+constexpr size_t kBlockBytes = 560;
+constexpr size_t kKeyBytes = 56;
+constexpr size_t kTreeNodeBytes = 64;
+
+// A stop request shared by the threads of one ray cast, and the bytes their
+// cells take: the first to see the request fired, or the bytes over their
+// limit, tells the others, which then return at their next poll.
 class SharedStop {
  public:
-  explicit SharedStop(const MapStopRequest& request) : request_(request) {}
+  SharedStop(const MapStopRequest& request, size_t max_bytes)
+      : request_(request), max_bytes_(max_bytes) {}
 
   bool Poll() {
     if (fired_.load(std::memory_order_relaxed)) return true;
@@ -44,11 +54,24 @@ class SharedStop {
     return fired_.load(std::memory_order_relaxed);
   }
 
+  // Counts `bytes` more; past the limit, stops every thread.
+  void Take(size_t bytes) {
+    if (bytes == 0 || max_bytes_ == 0) return;
+    if (taken_.fetch_add(bytes, std::memory_order_relaxed) + bytes > max_bytes_) {
+      over_limit_.store(true, std::memory_order_relaxed);
+      fired_.store(true, std::memory_order_relaxed);
+    }
+  }
+
   bool fired() const { return fired_.load(std::memory_order_relaxed); }
+  bool over_limit() const { return over_limit_.load(std::memory_order_relaxed); }
 
  private:
   const MapStopRequest& request_;
+  const size_t max_bytes_;
+  std::atomic<size_t> taken_{0};
   std::atomic<bool> fired_{false};
+  std::atomic<bool> over_limit_{false};
 };
 
 // An OcTree whose updates skip OctoMap's early-abort search. updateNode
@@ -87,14 +110,19 @@ class CellSet {
            static_cast<BlockId>(key[2] >> 4);
   }
 
-  void Insert(const OcTreeKey& key) {
+  // Returns true when the key's block is new.
+  bool Insert(const OcTreeKey& key) {
     const BlockId id = BlockOf(key);
+    bool created = false;
     if (id != last_id_ || last_ == nullptr) {
-      last_ = &blocks_[id];  // value-initialised: all bits clear
+      const auto [block, inserted] = blocks_.try_emplace(id);  // value-initialised: all bits clear
+      last_ = &block->second;
       last_id_ = id;
+      created = inserted;
     }
     const unsigned bit = BitOf(key);
     (*last_)[bit >> 6] |= uint64_t{1} << (bit & 63);
+    return created;
   }
 
   void Erase(const OcTreeKey& key) {
@@ -111,6 +139,8 @@ class CellSet {
     }
     last_ = nullptr;
   }
+
+  size_t Blocks() const { return blocks_.size(); }
 
   size_t Count() const {
     size_t count = 0;
@@ -204,9 +234,12 @@ void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints
   const size_t shards = cells.free.size();
   octomap::KeyRay ray;
   const auto mark_free = [&] {
+    size_t new_blocks = 0;
     for (const OcTreeKey& key : ray) {
-      cells.free[shards == 1 ? 0 : ShardOf(CellSet::BlockOf(key), shards)].Insert(key);
+      new_blocks +=
+          cells.free[shards == 1 ? 0 : ShardOf(CellSet::BlockOf(key), shards)].Insert(key);
     }
+    stop.Take(new_blocks * kBlockBytes);
   };
   for (size_t i = begin; i < end; ++i) {
     if ((i - begin) % kRaysPerStopPoll == 0 && stop.Poll()) return;
@@ -214,8 +247,9 @@ void CastRays(const octomap::OcTree& tree, const std::vector<point3d>& endpoints
     if (max_range < 0.0 || (p - origin).norm() <= max_range) {
       if (tree.computeRayKeys(origin, p, ray)) mark_free();
       OcTreeKey key;
-      if (tree.coordToKeyChecked(p, key)) {
-        cells.occupied[ShardOf(CellSet::BlockOf(key), shards)].insert(key);
+      if (tree.coordToKeyChecked(p, key) &&
+          cells.occupied[ShardOf(CellSet::BlockOf(key), shards)].insert(key).second) {
+        stop.Take(kKeyBytes);
       }
     } else {
       const point3d direction = (p - origin).normalized();
@@ -265,14 +299,22 @@ size_t ScanUpdate::OccupiedCells() const {
   return count;
 }
 
+size_t ScanUpdate::Bytes() const {
+  size_t blocks = 0;
+  for (const CellSet& shard : impl_->cells.free) blocks += shard.Blocks();
+  return blocks * kBlockBytes + OccupiedCells() * kKeyBytes;
+}
+
 struct OccupancyMap::Impl {
-  explicit Impl(const OccupancySettings& s) : settings(s), tree(s.resolution) {
+  Impl(const OccupancySettings& s, size_t max_bytes)
+      : settings(s), max_tree_bytes(max_bytes), tree(s.resolution) {
     tree.setProbHit(s.prob_hit);
     tree.setProbMiss(s.prob_miss);
     tree.setClampingThresMin(s.clamp_min);
     tree.setClampingThresMax(s.clamp_max);
   }
   OccupancySettings settings;
+  size_t max_tree_bytes;  // 0 = no cap
   FusionOcTree tree;
   bool inner_dirty = false;  // lazy insertion leaves inner nodes stale until updated
 
@@ -295,9 +337,9 @@ void ValidateOccupancySettings(const OccupancySettings& s) {
                           "clamping thresholds must satisfy 0 < clamp_min < clamp_max < 1");
 }
 
-OccupancyMap::OccupancyMap(const OccupancySettings& settings) {
+OccupancyMap::OccupancyMap(const OccupancySettings& settings, size_t max_tree_bytes) {
   ValidateOccupancySettings(settings);
-  impl_ = std::make_unique<Impl>(settings);
+  impl_ = std::make_unique<Impl>(settings, max_tree_bytes);
 }
 
 OccupancyMap::~OccupancyMap() = default;
@@ -309,7 +351,7 @@ void OccupancyMap::InsertScan(const Points& points, const Transform& T_map_scan,
 
 ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_map_scan,
                                        const Point& sensor_origin, int threads,
-                                       const MapStopRequest& stop) const {
+                                       const MapStopRequest& stop, size_t max_bytes) const {
   const octomap::OcTree& tree = impl_->tree;
   const std::vector<point3d> endpoints = DiscretisedEndpoints(tree, ToMapFrame(points, T_map_scan));
   const Point origin_d =
@@ -322,12 +364,16 @@ ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_
   const size_t chunk_count = std::max<size_t>(1, std::min(workers, endpoints.size()));
   const size_t shards = workers;
   std::vector<ShardedCells> chunks(chunk_count, ShardedCells(shards));
-  SharedStop shared_stop(stop);
+  SharedStop shared_stop(stop, max_bytes);
   ParallelFor(chunk_count, threads, [&](size_t c) {
     const size_t begin = endpoints.size() * c / chunk_count;
     const size_t end = endpoints.size() * (c + 1) / chunk_count;
     CastRays(tree, endpoints, begin, end, origin, max_range, chunks[c], shared_stop);
   });
+  if (shared_stop.over_limit()) {
+    throw LimitExceeded("the rays of one scan cross cells that take more than " +
+                        std::to_string(max_bytes >> 20) + " MB");
+  }
   if (shared_stop.fired()) throw Cancelled();
 
   ScanUpdate update;
@@ -341,7 +387,13 @@ void OccupancyMap::ApplyUpdate(const ScanUpdate& update, const MapStopRequest& s
   impl_->inner_dirty = true;
   size_t cells = 0;
   const auto update_cell = [&](const OcTreeKey& key, bool occupied) {
-    if (++cells % kCellsPerStopPoll == 0 && stop && stop()) throw Cancelled();
+    if (++cells % kCellsPerStopPoll == 0) {
+      if (stop && stop()) throw Cancelled();
+      if (impl_->max_tree_bytes != 0 && TreeBytes() > impl_->max_tree_bytes) {
+        throw LimitExceeded("the map's tree takes more than " +
+                            std::to_string(impl_->max_tree_bytes >> 20) + " MB");
+      }
+    }
     tree.Update(key, occupied);
   };
   for (const CellSet& shard : update.impl_->cells.free) {
@@ -351,6 +403,8 @@ void OccupancyMap::ApplyUpdate(const ScanUpdate& update, const MapStopRequest& s
     for (const OcTreeKey& key : shard) update_cell(key, /*occupied=*/true);
   }
 }
+
+size_t OccupancyMap::TreeBytes() const { return impl_->tree.size() * kTreeNodeBytes; }
 
 size_t OccupancyMap::OccupiedLeaves() {
   impl_->UpdateInner();

@@ -34,6 +34,16 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
                                   const BoIcpConfig& job_config, ScanPyramidCache& pyramids,
                                   const std::function<bool()>& stop_requested = {});
 
+/// The finest search or refinement voxel accepted, as a fraction of the
+/// scans' extent: finer ones downsample nothing more, and only push voxel
+/// keys towards their range.
+constexpr double kMinVoxelOfExtent = 1e-5;
+
+/// Throws InputError naming `voxel` or `refine_voxel` when the one the
+/// config uses is under kMinVoxelOfExtent times `extent` (metres, the
+/// farthest point of any scan from its frame's origin; 0 = unknown).
+void RequireVoxelsFitExtent(const BoIcpConfig& config, double extent);
+
 /// Which map settings a batch leaves to be chosen from its scans.
 struct MapAutoFields {
   bool resolution = true;  // OccupancySettings::resolution, reported as "map_resolution"

@@ -56,6 +56,10 @@ struct MapBuildSettings {
   /// than one, the tree update of one scan also overlaps the ray casting of
   /// the next. The outputs are the same bytes whatever the count.
   int fusion_threads = 1;
+  /// Heap bytes fusion may hold (0 = no limit): three quarters for the
+  /// tree, a quarter for the ray-cast cells of the scans in flight. FuseScans throws
+  /// LimitExceeded, naming --max-fusion-mb, rather than pass it.
+  size_t max_fusion_bytes = 0;
 };
 
 /// Where to write each output; an empty path skips that output. Every file
@@ -91,8 +95,9 @@ struct FusionSummary {
 /// at once (one ray cast while the one before updates the tree), so memory
 /// beyond the tree and the voxel-downsampled cloud does not grow with the
 /// number of scans. Throws InputError for invalid settings or a
-/// scan that no longer loads, Cancelled when stop_requested fires, and
-/// std::runtime_error when an output cannot be written.
+/// scan that no longer loads, Cancelled when stop_requested fires,
+/// LimitExceeded past settings.max_fusion_bytes, and std::runtime_error
+/// when an output cannot be written.
 FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
                         const MapBuildSettings& settings, const MapOutputPaths& outputs,
                         const AssemblyCallbacks& callbacks = {});

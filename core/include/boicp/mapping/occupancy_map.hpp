@@ -43,6 +43,8 @@ class ScanUpdate {
 
   size_t FreeCells() const;
   size_t OccupiedCells() const;
+  /// Heap bytes the cells take, estimated from their count.
+  size_t Bytes() const;
 
  private:
   friend class OccupancyMap;
@@ -52,8 +54,9 @@ class ScanUpdate {
 
 class OccupancyMap {
  public:
-  /// Throws InputError for invalid settings.
-  explicit OccupancyMap(const OccupancySettings& settings);
+  /// `max_tree_bytes` caps TreeBytes(): ApplyUpdate throws LimitExceeded
+  /// beyond it (0 = no cap). Throws InputError for invalid settings.
+  explicit OccupancyMap(const OccupancySettings& settings, size_t max_tree_bytes = 0);
   ~OccupancyMap();
   OccupancyMap(const OccupancyMap&) = delete;
   OccupancyMap& operator=(const OccupancyMap&) = delete;
@@ -70,18 +73,24 @@ class OccupancyMap {
   /// it reads only the map's settings, so it may run while another thread
   /// applies an earlier update. The cells are the ones OctoMap's discretised
   /// insertPointCloud updates, whatever the thread count. Polls `stop` every
-  /// few hundred rays and throws Cancelled once it fires.
+  /// few hundred rays and throws Cancelled once it fires. Throws
+  /// LimitExceeded once the cells cast take more than `max_bytes` (0 = no
+  /// limit); merging them may take as much again.
   ScanUpdate ComputeUpdate(const Points& points, const Transform& T_map_scan,
-                           const Point& sensor_origin, int threads,
-                           const MapStopRequest& stop = {}) const;
+                           const Point& sensor_origin, int threads, const MapStopRequest& stop = {},
+                           size_t max_bytes = 0) const;
 
   /// Applies an update computed by this map's ComputeUpdate: a miss for every
   /// free cell, then a hit for every occupied one. Each cell is in at most one
   /// of the two sets, so the tree does not depend on the order within a set
   /// and is bit-identical to OctoMap's own insertion of the same scan.
-  /// Polls `stop` every few ten thousand cells; a Cancelled thrown from it
-  /// leaves the map part-updated, fit only to be discarded.
+  /// Polls `stop` every few ten thousand cells; a Cancelled thrown from it,
+  /// or a LimitExceeded once the tree passes its cap, leaves the map
+  /// part-updated, fit only to be discarded.
   void ApplyUpdate(const ScanUpdate& update, const MapStopRequest& stop = {});
+
+  /// Heap bytes the tree takes, estimated from its node count.
+  size_t TreeBytes() const;
 
   /// Number of leaves currently believed occupied (after inner nodes are updated).
   size_t OccupiedLeaves();

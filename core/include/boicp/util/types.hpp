@@ -25,6 +25,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Thrown when work would need more memory than its limit allows. The
+/// message names the limit, what was needed and what to change.
+class LimitExceeded : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Applies T to every point: returns { T * p }.
 Points TransformPoints(const Transform& T, const Points& points);
 
