@@ -36,6 +36,9 @@ RUN useradd --system --uid 10001 --user-group --home-dir /var/lib/boicpd \
  && mkdir -p /var/lib/boicpd \
  && chown boicp:boicp /var/lib/boicpd
 # boicpd reads every flag from BOICPD_<FLAG> as well; the client reads BOICP_SERVER.
+# On 0.0.0.0 boicpd is closed by default: it starts only with a token
+# (BOICPD_AUTH_TOKEN_FILE, mounted) and TLS for it (BOICPD_TLS_CERT,
+# BOICPD_TLS_KEY), or BOICPD_INSECURE=1 / BOICPD_INSECURE_NO_AUTH=1 set on purpose.
 ENV BOICPD_LISTEN=0.0.0.0:50051 \
     BOICPD_DATA_DIR=/var/lib/boicpd \
     BOICP_SERVER=127.0.0.1:50051

@@ -13,10 +13,6 @@
 namespace boicp::server {
 namespace {
 
-bool IsLoopback(const std::string& host) {
-  return host == "127.0.0.1" || host == "localhost" || host == "[::1]" || host == "::1";
-}
-
 // Bounds what clients can hold open: gRPC's memory, calls per connection,
 // connections that stopped answering or sit idle.
 void ApplyTransportLimits(const DaemonOptions& o, grpc::ServerBuilder& builder) {
@@ -81,9 +77,11 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   address_ = host + ":" + std::to_string(port);
   manager_->Start();
 
-  if (!IsLoopback(host) && !auth_.enabled()) {
-    spdlog::warn("serving {} without --auth-token-file: anyone who reaches it can submit jobs",
-                 address_);
+  if (!IsLoopbackHost(host) && !auth_.enabled() && options_.tls_client_ca.empty()) {
+    spdlog::warn(
+        "serving {} without a token (--insecure-no-auth): anyone who reaches it can "
+        "submit jobs",
+        address_);
   }
   spdlog::info("boicpd {} workers x {} registration threads, {} concurrent jobs, data in {}",
                options_.workers, options_.registration_threads, options_.concurrent_jobs,

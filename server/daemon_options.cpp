@@ -108,9 +108,17 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "0 = no cap (the free-space reserve still holds)")
       ->capture_default_str()
       ->envname("BOICPD_MAX_STORED_GB");
-  app.add_option("--auth-token-file", o.auth_token_file,
+  app.add_option("--token-file,--auth-token-file", o.auth_token_file,
                  "Require 'authorization: Bearer <token>' with the token in this file")
       ->envname("BOICPD_AUTH_TOKEN_FILE");
+  app.add_flag("--insecure-no-auth", o.insecure_no_auth,
+               "Serve a non-loopback --listen without a token: anyone who reaches it can "
+               "submit jobs")
+      ->envname("BOICPD_INSECURE_NO_AUTH");
+  app.add_flag("--insecure", o.insecure,
+               "Accept the token over plaintext on a non-loopback --listen (readable by "
+               "anyone on the path)")
+      ->envname("BOICPD_INSECURE");
   app.add_option("--tls-cert", o.tls_cert, "PEM certificate chain (TLS on with --tls-key)")
       ->envname("BOICPD_TLS_CERT");
   app.add_option("--tls-key", o.tls_key, "PEM private key")->envname("BOICPD_TLS_KEY");
@@ -125,6 +133,34 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
       ->capture_default_str()
       ->envname("BOICPD_LOG_LEVEL");
 }
+
+bool IsLoopbackHost(const std::string& host) {
+  return host == "127.0.0.1" || host == "localhost" || host == "[::1]" || host == "::1";
+}
+
+namespace {
+
+// Closed by default: what reaches beyond this machine is authenticated, and
+// its token does not cross the network in plaintext, unless a flag says so.
+void RequireClosedExposure(const DaemonOptions& o) {
+  const std::string host = o.listen.substr(0, o.listen.rfind(':'));
+  if (IsLoopbackHost(host)) return;
+  const bool authenticated = !o.auth_token_file.empty() || !o.tls_client_ca.empty();
+  if (!authenticated && !o.insecure_no_auth) {
+    throw std::invalid_argument(
+        "--listen " + o.listen +
+        " reaches beyond this machine: give a bearer token with --token-file FILE (and TLS "
+        "with --tls-cert and --tls-key), or --insecure-no-auth to serve anyone who can reach it");
+  }
+  if (!o.auth_token_file.empty() && o.tls_cert.empty() && !o.insecure) {
+    throw std::invalid_argument(
+        "--token-file: on --listen " + o.listen +
+        " the token would cross the network in plaintext; give --tls-cert and --tls-key, or "
+        "--insecure to accept it anyway");
+  }
+}
+
+}  // namespace
 
 void ValidateDaemonOptions(const DaemonOptions& o) {
   auto require = [](bool ok, const std::string& message) {
@@ -159,6 +195,7 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.keepalive_s >= 1 && o.keepalive_timeout_s >= 1 && o.idle_connection_s >= 1,
           "--keepalive, --keepalive-timeout and --idle-connection must be at least 1 s");
   require(o.upload_idle_s >= 1, "--upload-idle-timeout must be at least 1 s");
+  RequireClosedExposure(o);
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "critical"};
   require(std::find(levels.begin(), levels.end(), o.log_level) != levels.end(),
           "--log-level must be trace, debug, info, warn, error or critical");

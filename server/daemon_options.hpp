@@ -32,8 +32,10 @@ struct DaemonOptions {
   int keepalive_s = 60;                              // ping an idle connection this often
   int keepalive_timeout_s = 20;                      // and close it when the ping is not answered
   int idle_connection_s = 600;                       // close a connection with no call this long
-  int upload_idle_s = 60;  // cancel an upload that sends nothing this long
-  std::string auth_token_file;
+  int upload_idle_s = 60;         // cancel an upload that sends nothing this long
+  std::string auth_token_file;    // --token-file (alias --auth-token-file)
+  bool insecure_no_auth = false;  // serve a non-loopback address without a token
+  bool insecure = false;          // accept a token over plaintext on a non-loopback address
   std::string tls_cert, tls_key;
   std::string tls_client_ca;      // require client certificates signed by this CA (mutual TLS)
   double shutdown_grace_s = 5.0;  // how long SIGTERM waits for open calls
@@ -43,7 +45,13 @@ struct DaemonOptions {
 /// Registers the flags on `app`, writing into `options`.
 void AddDaemonOptions(CLI::App& app, DaemonOptions& options);
 
-/// Throws std::invalid_argument naming the first flag out of range.
+/// True for the loopback hosts of --listen (127.0.0.1, localhost, ::1).
+bool IsLoopbackHost(const std::string& host);
+
+/// Throws std::invalid_argument naming the first flag out of range, and
+/// when a non-loopback --listen is left open: without a token (or client
+/// certificates) unless --insecure-no-auth, or with a token over plaintext
+/// unless --insecure.
 void ValidateDaemonOptions(const DaemonOptions& options);
 
 /// Throws std::invalid_argument when BOICPD_AUTH_TOKEN_FILE is set but empty

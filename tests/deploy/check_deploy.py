@@ -39,7 +39,9 @@ def package_lists(root):
 
 def daemon_env_options(boicpd):
     """{flag: (env, default or None)} from `boicpd --help`, the code's own view."""
-    pattern = re.compile(r"^\s+(--[a-z-]+) [A-Z]+(?:=(\S+))?(?: REQUIRED)? \(Env:(\w+)\)")
+    # "--name[,--alias] [TYPE[=default]] [REQUIRED] (Env:VAR)"; flags have no TYPE.
+    pattern = re.compile(
+        r"^\s+(--[a-z-]+)(?:,--[a-z-]+)*(?: [A-Z]+(?:=(\S+))?)?(?: REQUIRED)? \(Env:(\w+)\)")
     options = {}
     for line in run([boicpd, "--help"]).splitlines():
         m = pattern.match(line)
@@ -363,10 +365,15 @@ def check_manifests(args):
         if pod is None:
             continue
         problems += check_pod(name, pod, image, uid, known_env)
+        if pod.get("automountServiceAccountToken") is not False:
+            problems.append(f"{name}: automountServiceAccountToken must be false")
         if kind == "Job" and doc["spec"].get("completionMode") == "Indexed":
             problems += check_indexed_job(name, doc)
         if kind == "Deployment":
             problems += check_daemon_pod(name, pod["containers"][0])
+    policies = [doc for _, doc in docs if doc.get("kind") == "NetworkPolicy"]
+    if not any("boicpd" in str(p.get("spec", {}).get("podSelector")) for p in policies):
+        problems.append("deploy/k8s: no NetworkPolicy selects the boicpd pod")
     problems += check_compose(root, image, known_env)
     return problems
 
@@ -414,9 +421,16 @@ def check_daemon_pod(name, container):
     ports = [str(p["containerPort"]) for p in container.get("ports", [])]
     if port not in ports:
         problems.append(f"{name}: containerPort must be BOICPD_LISTEN's port {port}")
+    # boicpd serves TLS beyond loopback (closed by default), which native
+    # grpc probes cannot speak: each probe runs boicp health against it.
+    for key in ("BOICPD_AUTH_TOKEN_FILE", "BOICPD_TLS_CERT", "BOICPD_TLS_KEY"):
+        if not env.get(key):
+            problems.append(f"{name}: {key} must be set (a token, and TLS for it)")
+    health = ["boicp", "health", "--server", f"localhost:{port}",
+              "--tls-ca", env.get("BOICPD_TLS_CERT")]
     for probe in ("startupProbe", "readinessProbe", "livenessProbe"):
-        if str(container.get(probe, {}).get("grpc", {}).get("port")) != port:
-            problems.append(f"{name}: {probe} must be a grpc probe on port {port}")
+        if container.get(probe, {}).get("exec", {}).get("command") != health:
+            problems.append(f"{name}: {probe} must run {' '.join(map(str, health))}")
     cpu = str(container.get("resources", {}).get("requests", {}).get("cpu"))
     if env.get("BOICPD_WORKERS") != cpu:
         problems.append(f"{name}: BOICPD_WORKERS must equal the CPU request ({cpu})")

@@ -87,9 +87,10 @@ def check_outputs(folder, names, scans):
 class Daemon:
     """boicpd on a free loopback port, configured by variables as in compose."""
 
-    def __init__(self, bin_dir, data_dir, log_path):
+    def __init__(self, bin_dir, data_dir, log_path, token_file):
         env = base_env(bin_dir)
-        env.update(BOICPD_LISTEN="127.0.0.1:0", BOICPD_DATA_DIR=data_dir, BOICPD_WORKERS="1")
+        env.update(BOICPD_LISTEN="127.0.0.1:0", BOICPD_DATA_DIR=data_dir, BOICPD_WORKERS="1",
+                   BOICPD_AUTH_TOKEN_FILE=token_file)
         self.log_path = log_path
         self.log = open(log_path, "w", encoding="utf-8")
         self.process = subprocess.Popen(
@@ -140,11 +141,17 @@ def compose_submit(args, tmp):
     for name in ("source.xyz", "target.xyz"):
         os.rename(os.path.join(tmp, "demo", name), os.path.join(scans, name))
 
-    daemon = Daemon(args.bin_dir, os.path.join(tmp, "data"), os.path.join(tmp, "boicpd.log"))
+    # The compose file mounts the token at the daemon's BOICPD_AUTH_TOKEN_FILE
+    # and the client's --token-file alike.
+    token_target = compose["services"]["boicpd"]["environment"]["BOICPD_AUTH_TOKEN_FILE"]
+    token = os.path.join(tmp, "token")
+    with open(token, "w", encoding="utf-8") as f:
+        f.write("compose-test-token\n")
+    daemon = Daemon(args.bin_dir, os.path.join(tmp, "data"), os.path.join(tmp, "boicpd.log"), token)
     try:
         env = base_env(args.bin_dir)
         env.update(BOICP_SERVER=daemon.address, BOICP_CONFIG="A")
-        run_script(words, env, {"/scans": scans, "/out": out}, tmp)
+        run_script(words, env, {"/scans": scans, "/out": out, token_target: token}, tmp)
     finally:
         code = daemon.stop()
     if code != 0:

@@ -2,8 +2,10 @@
 # Builds the container image from ./Dockerfile and runs it the ways the README
 # describes:
 #   - the runtime image holds no compiler and no headers (its size is printed);
-#   - the daemon container on a named volume passes its HEALTHCHECK (boicp health)
-#     and runs as uid 10001;
+#   - with the image's own settings (0.0.0.0, no token) boicpd refuses to
+#     start, naming --token-file and --insecure-no-auth;
+#   - the daemon container, given a bearer token, on a named volume passes its
+#     HEALTHCHECK (boicp health) and runs as uid 10001;
 #   - the HOST client submits a drive (../shared/data/kitti00, or a generated
 #     drive when absent), exports map.bt and the trajectory, which must match
 #     the reference poses;
@@ -166,12 +168,27 @@ fi
 
 # ------------------------------------------------------------- the daemon
 
+# The image is closed by default: with its own settings (0.0.0.0, no token)
+# boicpd refuses to start, naming the flags that open it.
+"$engine" run --rm --no-healthcheck --network none "$image" >"$tmp/open.log" 2>&1 && fail "boicpd started open"
+grep -q -- '--token-file' "$tmp/open.log" && grep -q -- '--insecure-no-auth' "$tmp/open.log" \
+  || { cat "$tmp/open.log" >&2; fail "the refusal does not name --token-file and --insecure-no-auth"; }
+log "closed by default: $(head -n 1 "$tmp/open.log" | cut -c 1-80)..."
+
+# Every daemon below requires this bearer token; the host client sends it
+# (over loopback, so in plaintext: --insecure).
+token="$tmp/token"
+head -c 24 /dev/urandom | base64 >"$token"
+chmod 0644 "$token"
+auth=(--token-file "$token" --insecure)
+
 # Starts the daemon container NAME on VOLUME with a free port; sets BOICP_SERVER.
 start_daemon() {
   local name=$1 volume=$2 port
   port=$(free_port)
   export BOICP_SERVER="127.0.0.1:$port"
   local flags=(-d --name "$name" --network host -v "$volume:/var/lib/boicpd"
+    -v "$token:/run/secrets/boicpd-token:ro" -e BOICPD_AUTH_TOKEN_FILE=/run/secrets/boicpd-token
     -e "BOICPD_LISTEN=$BOICP_SERVER" -e "BOICP_SERVER=$BOICP_SERVER" -e BOICPD_WORKERS=2)
   # docker runs the HEALTHCHECK itself, every --health-interval; podman here has no
   # systemd timers, so the test runs it with `podman healthcheck run`.
@@ -204,10 +221,10 @@ wait_healthy() {
 submit_and_export() {
   local dir=$1 job
   mkdir -p "$dir"
-  job=$("$bin/boicp" submit "$scans" "${map_flags[@]}" --wait 2>"$dir/submit.log") \
+  job=$("$bin/boicp" submit "$scans" "${map_flags[@]}" "${auth[@]}" --wait 2>"$dir/submit.log") \
     || { tail -n 20 "$dir/submit.log" >&2; fail "boicp submit --wait"; }
-  "$bin/boicp" export "$job" -o "$dir/map.bt" >/dev/null
-  "$bin/boicp" export "$job" -o "$dir/trajectory.kitti" >/dev/null
+  "$bin/boicp" export "$job" -o "$dir/map.bt" "${auth[@]}" >/dev/null
+  "$bin/boicp" export "$job" -o "$dir/trajectory.kitti" "${auth[@]}" >/dev/null
   head -n 1 "$dir/map.bt" | grep -q '^# Octomap OcTree binary file' || fail "$dir/map.bt is not an OctoMap"
   python3 "$root/tests/deploy/check_trajectory.py" "$dir/trajectory.kitti" "${reference[@]}" \
     >"$dir/check.log" || { cat "$dir/check.log" >&2; fail "trajectory of job $job"; }
@@ -242,9 +259,9 @@ log "stop: drained, exit code 0"
 
 start_daemon "$tag-b" "$volume"
 wait_healthy "$tag-b"
-"$bin/boicp" show "$job" >"$tmp/show.log" 2>&1 || { cat "$tmp/show.log" >&2; fail "job $job is gone after a restart"; }
+"$bin/boicp" show "$job" "${auth[@]}" >"$tmp/show.log" 2>&1 || { cat "$tmp/show.log" >&2; fail "job $job is gone after a restart"; }
 grep -qi 'succeeded' "$tmp/show.log" || { cat "$tmp/show.log" >&2; fail "job $job is not succeeded after a restart"; }
-"$bin/boicp" export "$job" -o "$tmp/restart-map.bt" >/dev/null
+"$bin/boicp" export "$job" -o "$tmp/restart-map.bt" "${auth[@]}" >/dev/null
 cmp -s "$tmp/daemon/map.bt" "$tmp/restart-map.bt" || fail "map.bt differs after a restart"
 "$engine" stop -t 60 "$tag-b" >/dev/null 2>>"$tmp/stop.log"
 log "restart on the same volume: job $job still succeeded, same map.bt"
@@ -292,7 +309,7 @@ if [ "${#compose[@]}" -eq 0 ]; then
   exit 0
 fi
 compose_port=$(free_port)
-export BOICP_HOST_PORT="$compose_port"
+export BOICP_HOST_PORT="$compose_port" BOICP_TOKEN_FILE="$token"
 export BOICP_SERVER="127.0.0.1:$compose_port"
 compose+=(-p "$tag" -f "$root/deploy/docker-compose.yml")
 start=$(date +%s)

@@ -166,5 +166,36 @@ TEST_F(BadInput, EmptyAuthTokenVariableRefusesToStart) {
   EXPECT_THAT(output, HasSubstr("BOICPD_AUTH_TOKEN_FILE is set but empty"));
 }
 
+// Closed by default: a daemon reachable beyond this machine starts only
+// with a token (and TLS for it), or with the flag that opens it on purpose.
+TEST_F(BadInput, ANonLoopbackListenNeedsATokenAndTlsOrAnInsecureFlag) {
+  std::ofstream(dir_ / "token") << "s3cret\n";
+  const auto boicpd = [&](const std::string& flags) {
+    return RunCaptured("timeout 60 " + std::string(BOICPD_PATH) + " --data-dir " +
+                           (dir_ / "data").string() + " " + flags,
+                       dir_);
+  };
+  const RunResult open = boicpd("--listen 0.0.0.0:50051");
+  EXPECT_EQ(open.exit_code, 2) << open.err;
+  EXPECT_THAT(open.err, HasSubstr("--token-file"));
+  EXPECT_THAT(open.err, HasSubstr("--insecure-no-auth"));
+
+  const std::string token = " --token-file " + (dir_ / "token").string();
+  const RunResult plaintext = boicpd("--listen 0.0.0.0:50051" + token);
+  EXPECT_EQ(plaintext.exit_code, 2) << plaintext.err;
+  EXPECT_THAT(plaintext.err, HasSubstr("plaintext"));
+  EXPECT_THAT(plaintext.err, HasSubstr("--insecure"));
+
+  // The opt-ins start (and a SIGTERM from timeout drains them: exit 0).
+  for (const std::string& flags : {std::string("--insecure-no-auth"), "--insecure" + token}) {
+    const RunResult started =
+        RunCaptured("timeout --preserve-status -s TERM 3 " + std::string(BOICPD_PATH) +
+                        " --data-dir " + (dir_ / "data").string() + " --listen 0.0.0.0:0 " + flags,
+                    dir_);
+    EXPECT_EQ(started.exit_code, 0) << flags << "\n" << started.err;
+    EXPECT_THAT(started.out + started.err, HasSubstr("listening on")) << flags;
+  }
+}
+
 }  // namespace
 }  // namespace boicp::test
