@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "printable_text.hpp"
 #include "remote_json.hpp"
 #include "remote_options.hpp"
 
@@ -50,8 +51,9 @@ void PrintTable(const std::vector<v1::Job>& jobs) {
     const std::string pairs =
         std::to_string(job.pairs_done()) + "/" + std::to_string(job.pairs_total());
     std::printf("%-36s  %-9s  %-11s  %-11s  %5u  %-16s  %s\n", job.job_id().c_str(),
-                rpc::JobStateName(job.state()).c_str(), job.stage().c_str(), pairs.c_str(),
-                job.num_scans(), FormatTime(job.created_at()).c_str(), job.label().c_str());
+                rpc::JobStateName(job.state()).c_str(), PrintableText(job.stage()).c_str(),
+                pairs.c_str(), job.num_scans(), FormatTime(job.created_at()).c_str(),
+                PrintableText(job.label()).c_str());
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include "boicp/util/types.hpp"
 #include "commands.hpp"
+#include "printable_text.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -25,14 +26,6 @@ std::string Trim(const std::string& text) {
   return text.substr(begin, text.find_last_not_of(space) - begin + 1);
 }
 
-// gRPC messages may span lines; the error report must stay one line.
-std::string OneLine(std::string text) {
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  return text;
-}
-
 std::string DescribeRpcError(const rpc::RpcError& e, const RemoteFlags& flags) {
   switch (e.code()) {
     case grpc::StatusCode::UNAVAILABLE:
@@ -44,7 +37,7 @@ std::string DescribeRpcError(const rpc::RpcError& e, const RemoteFlags& flags) {
       return flags.token_file.empty()
                  ? "the daemon at " + flags.server +
                        " requires a token: pass --token-file FILE (the file given to boicpd "
-                       "--auth-token-file)"
+                       "--token-file)"
                  : "the daemon at " + flags.server + " rejected the token in " + flags.token_file +
                        " (" + e.detail() + ")";
     case grpc::StatusCode::NOT_FOUND:
@@ -69,7 +62,7 @@ void AddRemoteOptions(CLI::App& app, RemoteFlags& flags) {
       ->envname("BOICP_SERVER")
       ->capture_default_str();
   app.add_option("--token-file", flags.token_file,
-                 "File holding the bearer token (the daemon's --auth-token-file)");
+                 "File holding the bearer token (the daemon's --token-file)");
   app.add_option("--tls-ca", flags.tls_ca,
                  "PEM root certificates of a TLS daemon (else plaintext)");
   app.add_option("--tls-cert", flags.tls_cert,
@@ -116,7 +109,8 @@ Daemon ConnectToDaemon(const RemoteFlags& flags) {
 int RunRemote(const std::string& command, const RemoteFlags& flags,
               const std::function<int()>& body) {
   const auto report = [&](const std::string& message, int code) {
-    std::cerr << "boicp " << command << ": error: " << OneLine(message) << std::endl;
+    // The daemon's messages may span lines or carry what a client sent.
+    std::cerr << "boicp " << command << ": error: " << PrintableText(message) << std::endl;
     return code;
   };
   try {

@@ -7,6 +7,7 @@
 #include "boicp/mapping/batch_pair.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
+#include "printable_text.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -72,7 +73,7 @@ std::string ProgressBar(uint32_t done, uint32_t total, int width) {
 std::string ProgressLine(const v1::Job& job, const std::optional<v1::PairResult>& last_pair,
                          double pairs_per_min) {
   char text[256];
-  std::string line = "[" + job.stage() + "]";
+  std::string line = "[" + PrintableText(job.stage()) + "]";
   const bool registering = job.stage() == "registering" || job.stage() == "queued";
   if (registering || job.stage_total() == 0) {
     line +=

@@ -8,6 +8,7 @@
 #include "boicp/mapping/batch_pair.hpp"
 #include "boicp/settings/rung_summary.hpp"
 #include "commands.hpp"
+#include "printable_text.hpp"
 #include "remote_json.hpp"
 #include "remote_options.hpp"
 #include "remote_watch.hpp"
@@ -57,9 +58,10 @@ void PrintPairs(const v1::JobResults& results) {
 void PrintSummary(const v1::JobResults& results) {
   const v1::Job& job = results.job();
   std::printf("job         %s\n", job.job_id().c_str());
-  if (!job.label().empty()) std::printf("label       %s\n", job.label().c_str());
+  if (!job.label().empty()) std::printf("label       %s\n", PrintableText(job.label()).c_str());
   std::printf("state       %s (stage %s)%s\n", rpc::JobStateName(job.state()).c_str(),
-              job.stage().c_str(), job.cancel_requested() ? ", cancel requested" : "");
+              PrintableText(job.stage()).c_str(),
+              job.cancel_requested() ? ", cancel requested" : "");
   std::printf("scans       %u\n", job.num_scans());
   std::printf("pairs       %u of %u done, %u doubtful%s\n", job.pairs_done(), job.pairs_total(),
               job.pairs_doubtful(), job.pose_graph_optimised() ? ", pose graph optimised" : "");
@@ -68,7 +70,7 @@ void PrintSummary(const v1::JobResults& results) {
     std::printf("run time    %s%s\n", FormatDuration(end - job.started_at()).c_str(),
                 job.finished_at() > 0.0 ? "" : " so far");
   }
-  if (!job.error().empty()) std::printf("error       %s\n", job.error().c_str());
+  if (!job.error().empty()) std::printf("error       %s\n", PrintableText(job.error()).c_str());
   if (job.has_settings())
     std::printf("settings    %s\n", DescribeChosenSettings(job.settings()).c_str());
   if (results.pairs_size() > 0) PrintPairs(results);

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -79,7 +80,9 @@ DataDir::DataDir(const std::string& root) : root_(fs::absolute(root).lexically_n
     }
   }
   const std::string lock_path = (fs::path(root_) / "lock").string();
-  lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Owner only, also when an older daemon left it readable by all.
+  lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+  if (lock_fd_ >= 0) ::fchmod(lock_fd_, 0600);
   if (lock_fd_ < 0) {
     throw StorageError("data directory " + root_ + ": cannot open its lock file (" +
                        std::strerror(errno) + ")");

@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -52,6 +53,9 @@ int main(int argc, char** argv) {
   const sigset_t signals = ShutdownSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   ::signal(SIGPIPE, SIG_IGN);
+  // Scans, maps and the job store are the users' data: the daemon's group may
+  // read them, nobody else (a unit's or a container's own umask may be 022).
+  ::umask(027);
 
   try {
     boicp::server::Daemon daemon(options);

@@ -371,6 +371,22 @@ TEST_F(RemoteCli, UnknownJobAndBadInputGiveOneLineErrors) {
   EXPECT_TRUE(nlohmann::json::parse(jobs.out)["jobs"].empty());
 }
 
+// A label is whatever a client sent: printed raw, its escapes would retitle
+// the window and clear the screen of whoever lists the jobs.
+TEST_F(RemoteCli, ServerTextIsPrintedWithoutTerminalControls) {
+  StartDaemon();
+  WriteDrive(dir_ / "drive", 2, 5);
+  const std::string job = SubmitAndWait((dir_ / "drive").string() + kQuick +
+                                        " --label \"$(printf 'a\\033]0;owned\\007\\033[2Jb')\"");
+  for (const std::string& args : {std::string("jobs"), "show " + job}) {
+    const RunResult r = Run(args + server_);
+    ASSERT_EQ(r.exit_code, 0) << args << "\n" << r.err;
+    EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << args;
+    EXPECT_EQ(r.out.find('\x07'), std::string::npos) << args;
+    EXPECT_THAT(r.out, HasSubstr("a\\x1b]0;owned\\x07\\x1b[2Jb")) << args;
+  }
+}
+
 TEST_F(RemoteCli, TokenIsRequiredAndNeverPrinted) {
   std::ofstream(dir_ / "token") << "s3cret-token\n";
   std::ofstream(dir_ / "wrong") << "not-the-token\n";

@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include <gtest/gtest.h>
+
 extern char** environ;
 
 namespace boicp::test {
@@ -54,11 +56,32 @@ DaemonProcess::DaemonProcess(const std::vector<std::string>& args, const std::st
   throw std::runtime_error("boicpd did not listen within 60 s:\n" + Log());
 }
 
+namespace {
+
+// The first line of a sanitizer's report in a daemon's log, or "". A report
+// the daemon survived would otherwise pass unseen: halt_on_error stops only
+// the daemon, and a test may not notice.
+std::string SanitizerReport(const std::string& log) {
+  for (const char* marker : {"WARNING: ThreadSanitizer", "ERROR: AddressSanitizer",
+                             "ERROR: LeakSanitizer", "runtime error: "}) {
+    const size_t at = log.find(marker);
+    if (at == std::string::npos) continue;
+    const size_t begin = log.rfind('\n', at);
+    const size_t from = begin == std::string::npos ? 0 : begin + 1;
+    return log.substr(from, log.find('\n', at) - from);
+  }
+  return "";
+}
+
+}  // namespace
+
 DaemonProcess::~DaemonProcess() {
   if (pid_ > 0) {
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
+  const std::string report = SanitizerReport(Log());
+  if (!report.empty()) ADD_FAILURE() << "boicpd's log (" << log_path_ << ") holds: " << report;
 }
 
 void DaemonProcess::Signal(int signal_number) const {

@@ -1,6 +1,7 @@
 // Health checking, server reflection, job listing with paging, and TLS.
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 #include <gmock/gmock.h>
@@ -78,6 +79,25 @@ TEST_F(ServiceExtras, HealthReflectionAndPagedListing) {
   v1::ListJobsResponse bad;
   EXPECT_EQ(client.stub().ListJobs(&bad_context, request, &bad).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+// Scans, maps and the job store are the users' data: nothing the daemon
+// writes is readable by other users, and its lock file is its own alone.
+TEST_F(ServiceExtras, NothingInTheDataDirectoryIsReadableByOthers) {
+  namespace fs = std::filesystem;
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const std::string job_id = client.Submit(QuickBatch(UploadDrive(client, 2, 7))).job_id();
+  ASSERT_EQ(client.Watch(job_id).state(), v1::JOB_STATE_SUCCEEDED);
+  EXPECT_EQ(fs::status(data_dir_ / "lock").permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write);
+  int checked = 0;
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(data_dir_)) {
+    EXPECT_EQ(entry.symlink_status().permissions() & fs::perms::others_all, fs::perms::none)
+        << entry.path();
+    ++checked;
+  }
+  EXPECT_GT(checked, 8);  // the store, the scans, the job's outputs
 }
 
 TEST_F(ServiceExtras, UploadsEveryFormatAndDeduplicatesByContent) {
