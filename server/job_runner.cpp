@@ -16,6 +16,7 @@
 #include "job_pair_store.hpp"
 #include "job_spec.hpp"
 #include "scan_integrity.hpp"
+#include "service_error.hpp"
 
 namespace boicp::server {
 
@@ -294,7 +295,7 @@ class JobRun : public MapProgressSink {
   RunOutcome End(v1::JobState state, const std::string& error) {
     job_.set_state(state);
     job_.set_stage(state == v1::JOB_STATE_SUCCEEDED ? "done" : rpc::JobStateName(state));
-    job_.set_error(error);
+    job_.set_error(WithoutServerPaths(error));  // the log below keeps the whole message
     job_.set_finished_at(rpc::NowSeconds());
     job_.set_eta_seconds(state == v1::JOB_STATE_SUCCEEDED ? 0.0 : -1.0);
     job_.set_cancel_requested(control_.cancelled());

@@ -19,10 +19,16 @@ class ServiceError : public std::runtime_error {
   grpc::StatusCode code_;
 };
 
+/// `text` with every absolute path shortened to ".../" and its last name: a
+/// client learns which file, not where the daemon keeps its data.
+std::string WithoutServerPaths(const std::string& text);
+
 /// Converts the exception being handled (call only inside a catch block):
 /// ServiceError keeps its code, boicp::InputError becomes INVALID_ARGUMENT,
-/// StorageError FAILED_PRECONDITION, CorruptScanError DATA_LOSS, anything
-/// else INTERNAL, logged with `rpc` so that a bug is visible.
+/// LimitExceeded RESOURCE_EXHAUSTED, StorageError FAILED_PRECONDITION,
+/// CorruptScanError DATA_LOSS, anything else INTERNAL, logged with `rpc` so
+/// that a bug is visible. Replies carry WithoutServerPaths of the message;
+/// the log keeps it whole.
 grpc::Status StatusFromCurrentException(const char* rpc);
 
 /// Runs `handler` and converts whatever it throws with StatusFromCurrentException.

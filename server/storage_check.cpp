@@ -38,19 +38,20 @@ std::optional<std::string> CannotCreateFileIn(const std::string& dir) {
 
 }  // namespace
 
-std::optional<std::string> FindStorageProblem(const DataDir& dir, uint64_t reserve_bytes,
-                                              uint64_t incoming_bytes) {
+std::optional<StorageError> FindStorageProblem(const DataDir& dir, uint64_t reserve_bytes,
+                                               uint64_t incoming_bytes) {
   const std::string name = "data directory " + dir.root();
   for (const std::string& sub : dir.WritableDirs()) {
     if (const auto reason = CannotCreateFileIn(sub)) {
-      return name + " is not writable: cannot create a file in " + sub + " (" + *reason + ")";
+      return StorageError(name + " is not writable: cannot create a file in " + sub + " (" +
+                          *reason + ")");
     }
   }
   struct statvfs fs {};
   if (::statvfs(dir.root().c_str(), &fs) != 0) {
-    return name + ": cannot read its free space (" + std::strerror(errno) + ")";
+    return StorageError(name + ": cannot read its free space (" + std::strerror(errno) + ")");
   }
-  if (fs.f_files > 0 && fs.f_favail == 0) return name + " is full: no free inodes";
+  if (fs.f_files > 0 && fs.f_favail == 0) return StorageError(name + " is full: no free inodes");
   const uint64_t free_bytes = static_cast<uint64_t>(fs.f_bavail) * fs.f_frsize;
   const uint64_t needed = reserve_bytes > std::numeric_limits<uint64_t>::max() - incoming_bytes
                               ? std::numeric_limits<uint64_t>::max()
@@ -58,9 +59,12 @@ std::optional<std::string> FindStorageProblem(const DataDir& dir, uint64_t reser
   if (free_bytes >= needed) return std::nullopt;
   const std::string upload =
       incoming_bytes > 0 ? "; this upload needs " + Mebibytes(incoming_bytes) + " more" : "";
-  return name + " is nearly full: " + Mebibytes(free_bytes) + " free" + upload +
-         ", and boicpd keeps " + Mebibytes(reserve_bytes) + " free (--min-free-mb " +
-         std::to_string(reserve_bytes >> 20) + ")";
+  const std::string reserve = "boicpd keeps " + Mebibytes(reserve_bytes) + " free (--min-free-mb " +
+                              std::to_string(reserve_bytes >> 20) + ")";
+  // How much is free goes to the daemon's log, not to clients.
+  return StorageError(
+      name + " is nearly full: " + Mebibytes(free_bytes) + " free" + upload + ", and " + reserve,
+      name + " is nearly full" + upload + ": " + reserve);
 }
 
 void RequireStoredQuota(const DataDir& dir, uint64_t max_stored_bytes, uint64_t incoming_bytes) {
@@ -79,9 +83,7 @@ void RequireStoredQuota(const DataDir& dir, uint64_t max_stored_bytes, uint64_t 
 }
 
 void RequireStorage(const DataDir& dir, uint64_t reserve_bytes, uint64_t incoming_bytes) {
-  if (auto problem = FindStorageProblem(dir, reserve_bytes, incoming_bytes)) {
-    throw StorageError(*problem);
-  }
+  if (auto problem = FindStorageProblem(dir, reserve_bytes, incoming_bytes)) throw *problem;
 }
 
 }  // namespace boicp::server

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "data_dir.hpp"
+#include "storage_errors.hpp"
 
 namespace boicp::server {
 
@@ -16,11 +17,12 @@ namespace boicp::server {
 /// one of its writable directories refuses a new file (read-only, no
 /// permission, gone), no inode is free, or fewer than `reserve_bytes` +
 /// `incoming_bytes` bytes are free for unprivileged users. One line that
-/// names the directory and the reason.
-std::optional<std::string> FindStorageProblem(const DataDir& dir, uint64_t reserve_bytes,
-                                              uint64_t incoming_bytes = 0);
+/// names the directory and the reason (and, in the message but not the
+/// reply, the free space).
+std::optional<StorageError> FindStorageProblem(const DataDir& dir, uint64_t reserve_bytes,
+                                               uint64_t incoming_bytes = 0);
 
-/// Throws StorageError with FindStorageProblem's message when there is one.
+/// Throws FindStorageProblem's StorageError when there is one.
 void RequireStorage(const DataDir& dir, uint64_t reserve_bytes, uint64_t incoming_bytes = 0);
 
 /// Throws ServiceError RESOURCE_EXHAUSTED when the stored scans and outputs
