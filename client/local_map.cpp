@@ -76,6 +76,7 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   summary.poses = map.estimate.poses;
   summary.optimised = map.estimate.optimised;
   summary.occupied_leaves = map.fusion.occupied_leaves;
+  summary.points_out_of_range = map.fusion.points_out_of_range;
   summary.fusion_s = map.fusion.seconds;
   summary.pairs = static_cast<int>(listed.size());
   summary.pairs_doubtful = static_cast<int>(std::count_if(
@@ -100,6 +101,14 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
                "wrote %s/{map.bt,map.ot,trajectory.tum,trajectory.kitti,pairs.json,"
                "preview.png}: %zu occupied leaves\n",
                out_dir.c_str(), summary.occupied_leaves);
+  if (summary.points_out_of_range > 0) {
+    std::fprintf(
+        stderr,
+        "warning: %zu points lie over 32768 leaves from the map origin along an axis, beyond "
+        "what an OctoMap can hold, and were left out of the map; a coarser "
+        "--resolution reaches farther\n",
+        summary.points_out_of_range);
+  }
   std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
   const std::string rungs = settings::RungSummary(summary.answered_by);
   if (!rungs.empty()) std::fprintf(stderr, "%s\n", rungs.c_str());

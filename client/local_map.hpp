@@ -15,6 +15,7 @@ struct MapOutputSummary {
   std::vector<Transform> poses;  // T_map_scan
   bool optimised = false;
   size_t occupied_leaves = 0;
+  size_t points_out_of_range = 0;  // left out of the map: beyond its key range
   double fusion_s = 0.0;
   int pairs = 0;                  // listed in pairs.json
   int pairs_doubtful = 0;         // of which doubtful

@@ -265,6 +265,10 @@ class JobRun : public MapProgressSink {
     spdlog::info("job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points",
                  job_.job_id(), batch_.scans.size(), map.fusion.seconds, map.fusion.occupied_leaves,
                  map.fusion.cloud_points);
+    if (map.fusion.points_out_of_range > 0) {
+      spdlog::warn("job {}: {} points lie beyond the OctoMap's key range and were left out",
+                   job_.job_id(), map.fusion.points_out_of_range);
+    }
     std::vector<v1::TrajectoryPose> trajectory;
     const std::vector<double> stamps = ScanTimestamps(batch_.scans);
     for (size_t i = 0; i < batch_.scans.size(); ++i) {

@@ -166,6 +166,30 @@ TEST_F(FusionLimit, FuseScansStopsPastItAndWritesNothingButFusesWhatTheEstimateA
   EXPECT_TRUE(fs::exists(outputs.octomap_bt));
 }
 
+// At 1 cm leaves an OctoMap reaches 327.68 m from its origin along each
+// axis; a point beyond would wrap to a key on the far side and mark a leaf
+// that no scan saw.
+TEST(OccupancyMap, PointsBeyondTheKeyRangeAreLeftOutAndCounted) {
+  OccupancySettings settings;
+  settings.resolution = 0.01;
+  const Points near = {{1.0, 0.0, 0.0}, {1.0, 0.5, 0.0}, {0.0, 2.0, 0.5}};
+  Points with_far = near;
+  with_far.push_back({400.0, 0.0, 0.0});
+  with_far.push_back({-1000.0, 5.0, 0.0});
+  const auto fuse = [&](const Points& points, size_t* out_of_range) {
+    OccupancyMap map(settings);
+    const ScanUpdate update = map.ComputeUpdate(points, Transform::Identity(), Point::Zero(), 2);
+    *out_of_range = update.PointsOutOfRange();
+    map.ApplyUpdate(update);
+    return map.OccupiedLeaves();
+  };
+  size_t dropped_near = 0, dropped_far = 0;
+  const size_t leaves_near = fuse(near, &dropped_near);
+  EXPECT_EQ(fuse(with_far, &dropped_far), leaves_near);
+  EXPECT_EQ(dropped_near, 0u);
+  EXPECT_EQ(dropped_far, 2u);
+}
+
 TEST(RangeProfile, CountsEveryPointOnceAndKeepsTheFarthest) {
   const Points points = {{0, 0, 0}, {1, 0, 0}, {0, 2, 0}, {0, 0, 3000}};
   const RangeProfile profile = ProfileRanges(points);

@@ -130,6 +130,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   VoxelAccumulator cloud(cloud_voxel);
   const bool want_cloud = !outputs.cloud_ply.empty();
   const int total = static_cast<int>(scans.size());
+  size_t points_out_of_range = 0;  // counted by the one task that applies updates
 
   // A window of scans is applied to the tree, in scan order, while the next
   // window is loaded and ray cast, each of its scans on its own threads.
@@ -163,6 +164,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
         }
         for (size_t k = 0; k < current.size(); ++k) {
           map.ApplyUpdate(current[k].update, callbacks.stop_requested);
+          points_out_of_range += current[k].update.PointsOutOfRange();
           if (want_cloud) {
             cloud.Add(current[k].cloud_points, poses[static_cast<size_t>(first) + k]);
           }
@@ -180,6 +182,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   ThrowIfStopped(callbacks);
   Report(callbacks, "writing", 0, 1);
   FusionSummary summary;
+  summary.points_out_of_range = points_out_of_range;
   summary.occupied_leaves = map.OccupiedLeaves();
   // The .ot keeps full probabilities, so it goes before the .bt conversion.
   // A stop request is honoured during and between outputs too: each write

@@ -211,15 +211,21 @@ octomap::Pointcloud ToMapFrame(const Points& points, const Transform& T_map_scan
 }
 
 // One endpoint per leaf, at the leaf's centre: OctoMap's discretised
-// insertion (computeDiscreteUpdate), which casts one ray per leaf hit.
+// insertion (computeDiscreteUpdate), which casts one ray per leaf hit. A
+// point beyond the tree's key range (2^15 leaves from the origin each way)
+// would wrap to a key on the far side: it is left out and counted instead.
 std::vector<point3d> DiscretisedEndpoints(const octomap::OcTree& tree,
-                                          const octomap::Pointcloud& cloud) {
+                                          const octomap::Pointcloud& cloud, size_t& out_of_range) {
   KeySet leaves;
   std::vector<point3d> endpoints;
   endpoints.reserve(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) {
-    const OcTreeKey key = tree.coordToKey(cloud[i]);
-    if (leaves.insert(key).second) endpoints.push_back(tree.keyToCoord(key));
+    OcTreeKey key;
+    if (!tree.coordToKeyChecked(cloud[i], key)) {
+      ++out_of_range;
+    } else if (leaves.insert(key).second) {
+      endpoints.push_back(tree.keyToCoord(key));
+    }
   }
   return endpoints;
 }
@@ -279,7 +285,8 @@ void MergeShard(std::vector<ShardedCells>& chunks, size_t shard, ShardedCells& m
 
 struct ScanUpdate::Impl {
   explicit Impl(size_t shards) : cells(shards) {}
-  ShardedCells cells;  // free and occupied are disjoint
+  ShardedCells cells;       // free and occupied are disjoint
+  size_t out_of_range = 0;  // points left out: beyond the tree's key range
 };
 
 ScanUpdate::ScanUpdate() : impl_(std::make_unique<Impl>(1)) {}
@@ -298,6 +305,8 @@ size_t ScanUpdate::OccupiedCells() const {
   for (const KeySet& shard : impl_->cells.occupied) count += shard.size();
   return count;
 }
+
+size_t ScanUpdate::PointsOutOfRange() const { return impl_->out_of_range; }
 
 size_t ScanUpdate::Bytes() const {
   size_t blocks = 0;
@@ -353,7 +362,9 @@ ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_
                                        const Point& sensor_origin, int threads,
                                        const MapStopRequest& stop, size_t max_bytes) const {
   const octomap::OcTree& tree = impl_->tree;
-  const std::vector<point3d> endpoints = DiscretisedEndpoints(tree, ToMapFrame(points, T_map_scan));
+  size_t out_of_range = 0;
+  const std::vector<point3d> endpoints =
+      DiscretisedEndpoints(tree, ToMapFrame(points, T_map_scan), out_of_range);
   const Point origin_d =
       T_map_scan.topLeftCorner<3, 3>() * sensor_origin + T_map_scan.topRightCorner<3, 1>();
   const point3d origin(static_cast<float>(origin_d.x()), static_cast<float>(origin_d.y()),
@@ -378,6 +389,7 @@ ScanUpdate OccupancyMap::ComputeUpdate(const Points& points, const Transform& T_
 
   ScanUpdate update;
   update.impl_ = std::make_unique<ScanUpdate::Impl>(shards);
+  update.impl_->out_of_range = out_of_range;
   ParallelFor(shards, threads, [&](size_t s) { MergeShard(chunks, s, update.impl_->cells); });
   return update;
 }

@@ -35,12 +35,15 @@ VoxelAccumulator::VoxelAccumulator(double voxel) : voxel_(voxel) {
 void VoxelAccumulator::Add(const Points& points, const Transform& T) {
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+  // Beyond 2^62 voxels from the origin an index no longer fits the key (its
+  // cast would be undefined): such a point is left out, as a non-finite one is.
+  constexpr double kMaxIndex = 4.6e18;
   for (const Point& p : points) {
     const Point q = R * p + t;
-    if (!q.allFinite()) continue;
-    const Key key{static_cast<int64_t>(std::floor(q.x() / voxel_)),
-                  static_cast<int64_t>(std::floor(q.y() / voxel_)),
-                  static_cast<int64_t>(std::floor(q.z() / voxel_))};
+    const Eigen::Vector3d index = (q / voxel_).array().floor();
+    if (!index.allFinite() || index.cwiseAbs().maxCoeff() > kMaxIndex) continue;
+    const Key key{static_cast<int64_t>(index.x()), static_cast<int64_t>(index.y()),
+                  static_cast<int64_t>(index.z())};
     Cell& cell = cells_[key];
     cell.sum += q;
     ++cell.count;

@@ -86,6 +86,7 @@ struct AssemblyCallbacks {
 struct FusionSummary {
   size_t occupied_leaves = 0;
   size_t cloud_points = 0;
+  size_t points_out_of_range = 0;  // beyond the map's key range: left out of the tree
   double seconds = 0.0;
 };
 

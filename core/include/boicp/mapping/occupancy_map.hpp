@@ -43,6 +43,9 @@ class ScanUpdate {
 
   size_t FreeCells() const;
   size_t OccupiedCells() const;
+  /// Points left out because they lie beyond the map's key range (2^15
+  /// leaves from the map origin along any axis), where OctoMap would wrap them.
+  size_t PointsOutOfRange() const;
   /// Heap bytes the cells take, estimated from their count.
   size_t Bytes() const;
 

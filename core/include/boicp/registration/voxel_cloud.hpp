@@ -17,7 +17,8 @@ class VoxelAccumulator {
   /// Precondition: voxel > 0 (metres). Throws InputError otherwise.
   explicit VoxelAccumulator(double voxel);
 
-  /// Adds T * p for every p of `points`.
+  /// Adds T * p for every p of `points`; a point that is not finite, or lies
+  /// more than 2^62 voxels from the origin, is left out.
   void Add(const Points& points, const Transform& T = Transform::Identity());
 
   /// One centroid per occupied voxel, ordered by voxel index so that the
