@@ -77,7 +77,7 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   address_ = host + ":" + std::to_string(port);
   manager_->Start();
 
-  if (!IsLoopbackHost(host) && !auth_.enabled() && options_.tls_client_ca.empty()) {
+  if (IsOpenToAnyone(options_)) {
     spdlog::warn(
         "serving {} without a token (--insecure-no-auth): anyone who reaches it can "
         "submit jobs",

@@ -138,15 +138,18 @@ bool IsLoopbackHost(const std::string& host) {
   return host == "127.0.0.1" || host == "localhost" || host == "[::1]" || host == "::1";
 }
 
+bool IsOpenToAnyone(const DaemonOptions& o) {
+  const bool authenticated = !o.auth_token_file.empty() || !o.tls_client_ca.empty();
+  return !authenticated && !IsLoopbackHost(o.listen.substr(0, o.listen.rfind(':')));
+}
+
 namespace {
 
 // Closed by default: what reaches beyond this machine is authenticated, and
 // its token does not cross the network in plaintext, unless a flag says so.
 void RequireClosedExposure(const DaemonOptions& o) {
-  const std::string host = o.listen.substr(0, o.listen.rfind(':'));
-  if (IsLoopbackHost(host)) return;
-  const bool authenticated = !o.auth_token_file.empty() || !o.tls_client_ca.empty();
-  if (!authenticated && !o.insecure_no_auth) {
+  if (IsLoopbackHost(o.listen.substr(0, o.listen.rfind(':')))) return;
+  if (IsOpenToAnyone(o) && !o.insecure_no_auth) {
     throw std::invalid_argument(
         "--listen " + o.listen +
         " reaches beyond this machine: give a bearer token with --token-file FILE (and TLS "

@@ -48,6 +48,10 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& options);
 /// True for the loopback hosts of --listen (127.0.0.1, localhost, ::1).
 bool IsLoopbackHost(const std::string& host);
 
+/// True when the daemon serves beyond loopback with neither a token nor
+/// client certificates (which validation allows only with --insecure-no-auth).
+bool IsOpenToAnyone(const DaemonOptions& options);
+
 /// Throws std::invalid_argument naming the first flag out of range, and
 /// when a non-loopback --listen is left open: without a token (or client
 /// certificates) unless --insecure-no-auth, or with a token over plaintext
