@@ -73,8 +73,10 @@ TEST_F(DeleteJob, FinishedJobsPastTheirRetentionAreDeleted) {
   auto client = Client();
   const std::string job_id = client.Submit(QuickBatch(UploadDrive(client, 3, 64))).job_id();
   ASSERT_EQ(client.Watch(job_id).state(), v1::JOB_STATE_SUCCEEDED);
+  // The rows go first, then the folder (JobManager::Delete): wait for both.
   const auto started = std::chrono::steady_clock::now();
-  while (CodeOf([&] { client.GetJob(job_id); }) == grpc::StatusCode::OK &&
+  while ((CodeOf([&] { client.GetJob(job_id); }) == grpc::StatusCode::OK ||
+          fs::exists(data_dir_ / "jobs" / job_id)) &&
          std::chrono::steady_clock::now() - started < std::chrono::seconds(60)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
