@@ -6,14 +6,10 @@
 
 #include <open3d/Open3DConfig.h>
 
+#include "boicp/util/text.hpp"
+
 namespace boicp::bench {
 namespace {
-
-std::string Trim(const std::string& text) {
-  const size_t first = text.find_first_not_of(" \t");
-  const size_t last = text.find_last_not_of(" \t\r\n");
-  return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
-}
 
 std::string CpuModel() {
   std::ifstream cpuinfo("/proc/cpuinfo");

@@ -13,7 +13,6 @@
 #include <open3d/utility/Random.h>
 
 #include "boicp/registration/refinement.hpp"
-#include "dataset_config.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {
@@ -42,52 +41,54 @@ FeatureCloud ComputeFeatures(const Points& points, double voxel) {
 // bit for bit.
 void SeedOpen3d(uint64_t seed) { open3d::utility::random::Seed(static_cast<int>(seed >> 33)); }
 
-MethodOutput Refined(const Transform& initial, const FeatureCloud& source,
-                     const FeatureCloud& target, const MethodInput& input) {
-  const BoIcpConfig config = DatasetTableConfig("C", input);
-  const PreparedPair pair = PreparePair(input.source, input.target, config);
-  MethodOutput output;
+RegistrationResult Refined(const Transform& initial, const FeatureCloud& source,
+                           const FeatureCloud& target, const Points& raw_source,
+                           const Points& raw_target, const BoIcpConfig& config) {
+  const PreparedPair pair = PreparePair(raw_source, raw_target, config);
+  RegistrationResult output;
   const Transform centred = CentredTransform(pair.source_centre, pair.target_centre, initial);
   output.transform = UncentredTransform(pair.source_centre, pair.target_centre,
                                         RefineCoarseToFine({centred}, pair, config).transform);
   output.evaluations = 1;
   output.source_points = source.cloud->points_.size();
   output.target_points = target.cloud->points_.size();
-  output.voxel = input.dataset.voxel;
+  output.config = config;
   return output;
 }
 
 }  // namespace
 
-MethodOutput RunRansacFpfh(const MethodInput& input) {
-  const double voxel = input.dataset.voxel;
-  const FeatureCloud source = ComputeFeatures(input.source, voxel);
-  const FeatureCloud target = ComputeFeatures(input.target, voxel);
+RegistrationResult RunRansacFpfh(const Points& raw_source, const Points& raw_target,
+                                 const BoIcpConfig& config, bool quick) {
+  const double voxel = config.voxel;
+  const FeatureCloud source = ComputeFeatures(raw_source, voxel);
+  const FeatureCloud target = ComputeFeatures(raw_target, voxel);
   const double distance = 1.5 * voxel;
   const reg::CorrespondenceCheckerBasedOnEdgeLength edge_length(0.9);
   const reg::CorrespondenceCheckerBasedOnDistance close_enough(distance);
   // The smoke test only checks that the method runs, so it caps the iterations.
-  const int max_iterations = input.quick ? 20000 : 100000;
-  SeedOpen3d(input.seed);
+  const int max_iterations = quick ? 20000 : 100000;
+  SeedOpen3d(config.seed);
   const reg::RegistrationResult global = reg::RegistrationRANSACBasedOnFeatureMatching(
       *source.cloud, *target.cloud, *source.fpfh, *target.fpfh, /*mutual_filter=*/true, distance,
       reg::TransformationEstimationPointToPoint(false), 3, {edge_length, close_enough},
       reg::RANSACConvergenceCriteria(max_iterations, 0.999));
-  return Refined(global.transformation_, source, target, input);
+  return Refined(global.transformation_, source, target, raw_source, raw_target, config);
 }
 
-MethodOutput RunFastGlobal(const MethodInput& input) {
-  const double voxel = input.dataset.voxel;
-  const FeatureCloud source = ComputeFeatures(input.source, voxel);
-  const FeatureCloud target = ComputeFeatures(input.target, voxel);
-  SeedOpen3d(input.seed);
+RegistrationResult RunFastGlobal(const Points& raw_source, const Points& raw_target,
+                                 const BoIcpConfig& config) {
+  const double voxel = config.voxel;
+  const FeatureCloud source = ComputeFeatures(raw_source, voxel);
+  const FeatureCloud target = ComputeFeatures(raw_target, voxel);
+  SeedOpen3d(config.seed);
   // Absolute scale: the gate is in metres like every other method's, not a
   // fraction of the cloud's diameter.
   const reg::FastGlobalRegistrationOption option(1.4, /*use_absolute_scale=*/true, true,
                                                  1.5 * voxel, 64, 0.95, 1000, true);
   const reg::RegistrationResult global = reg::FastGlobalRegistrationBasedOnFeatureMatching(
       *source.cloud, *target.cloud, *source.fpfh, *target.fpfh, option);
-  return Refined(global.transformation_, source, target, input);
+  return Refined(global.transformation_, source, target, raw_source, raw_target, config);
 }
 
 }  // namespace boicp::bench

@@ -2,26 +2,25 @@
 // how far the perturbation is outside ICP's basin.
 
 #include "boicp/registration/refinement.hpp"
-#include "dataset_config.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {
 
-MethodOutput RunIcpFromIdentity(const MethodInput& input) {
-  const BoIcpConfig config = DatasetTableConfig("C", input);
-  const PreparedPair pair = PreparePair(input.source, input.target, config);
+RegistrationResult RunIcpFromIdentity(const Points& source, const Points& target,
+                                      const BoIcpConfig& config) {
+  const PreparedPair pair = PreparePair(source, target, config);
   const Transform identity =
       CentredTransform(pair.source_centre, pair.target_centre, Transform::Identity());
   const Transform coarse =
       AlignPointToPoint(pair.search_source, pair.search_target, identity, SearchIcpOptions(config))
           .transform;
-  MethodOutput output;
+  RegistrationResult output;
   output.transform = UncentredTransform(pair.source_centre, pair.target_centre,
                                         RefineCoarseToFine({coarse}, pair, config).transform);
   output.evaluations = 1;
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();
-  output.voxel = config.voxel;
+  output.config = config;
   return output;
 }
 

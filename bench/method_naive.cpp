@@ -12,48 +12,33 @@
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/Registration.h>
 
-#include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "dataset_config.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {
 
-MethodOutput RunNaiveBoIcp(const MethodInput& input) {
+RegistrationResult RunNaiveBoIcp(const Points& source, const Points& target,
+                                 const BoIcpConfig& table_config,
+                                 const RegistrationCallbacks& given_callbacks) {
   namespace reg = open3d::pipelines::registration;
-  BoIcpConfig config = DatasetBoConfig("C", input);
-  // The ICP below reads the config's gate, so automatic settings are chosen first.
-  ApplyChosenSettings(
-      ChooseSettingsForClouds({&input.source, &input.target},
-                              DeclareSensor(config.sensor, CloudFormat::kAuto), config.seed),
-      config);
+  BoIcpConfig config = table_config;
   config.retry_when_doubtful = false;                  // the paper's method searches once
   config.icp_objective = IcpObjective::kPointToPoint;  // what local_icp below runs
   config.bo.batch_size = 1;
   config.bo.refit_every = 1;
   config.evaluation_points = 0;
-  RegistrationCallbacks callbacks;
-  callbacks.local_icp = [&config](const Points& source, const Points& target,
+  RegistrationCallbacks callbacks = given_callbacks;
+  callbacks.local_icp = [&config](const Points& source_points, const Points& target_points,
                                   const Transform& initial) {
-    const open3d::geometry::PointCloud source_cloud(source);
-    const open3d::geometry::PointCloud target_cloud(target);
+    const open3d::geometry::PointCloud source_cloud(source_points);
+    const open3d::geometry::PointCloud target_cloud(target_points);
     return Transform(
         reg::RegistrationICP(source_cloud, target_cloud, config.EffectiveMaxCorrespondence(),
                              initial, reg::TransformationEstimationPointToPoint(false),
                              reg::ICPConvergenceCriteria(1e-6, 1e-6, config.icp_max_iterations))
             .transformation_);
   };
-  const RegistrationResult result =
-      RegisterPair(input.source, input.target, config, std::nullopt, callbacks);
-  MethodOutput output;
-  output.transform = result.transform;
-  output.confidence = result.confidence;
-  output.evaluations = result.evaluations;
-  output.source_points = result.source_points;
-  output.target_points = result.target_points;
-  output.voxel = config.voxel;
-  output.iterations = config.iterations;
-  return output;
+  return RegisterPair(source, target, config, std::nullopt, callbacks);
 }
 
 }  // namespace boicp::bench

@@ -16,7 +16,6 @@
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/search_space.hpp"
 #include "boicp/util/parallel_for.hpp"
-#include "dataset_config.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {
@@ -134,13 +133,13 @@ std::vector<Candidate> PyramidStage(const SearchSpace& space, GridScorer& scorer
 
 }  // namespace
 
-MethodOutput RunPyramid(const MethodInput& input) {
-  const PyramidBudget budget = BudgetFor(input.quick);
-  const BoIcpConfig config = DatasetTableConfig("C", input);
-  const PreparedPair pair = PreparePair(input.source, input.target, config);
-  const Points score_points = RandomSubsample(pair.search_source, budget.score_points, input.seed);
+RegistrationResult RunPyramid(const Points& source, const Points& target, const BoIcpConfig& config,
+                              bool quick) {
+  const PyramidBudget budget = BudgetFor(quick);
+  const PreparedPair pair = PreparePair(source, target, config);
+  const Points score_points = RandomSubsample(pair.search_source, budget.score_points, config.seed);
   const double gate = config.EffectiveMaxCorrespondence();
-  GridScorer scorer(score_points, pair.search_target, gate, input.threads);
+  GridScorer scorer(score_points, pair.search_target, gate, config.threads);
 
   // The same box as BO-ICP: centroids on top of each other, rotations about them.
   Transform anchor = Transform::Identity();
@@ -164,7 +163,7 @@ MethodOutput RunPyramid(const MethodInput& input) {
                           translation_space.ToTransform(candidate.u), SearchIcpOptions(config))
             .transform;
     const double objective =
-        ScoreAlignment(pair.search_source, pair.search_target, T, gate, input.threads)
+        ScoreAlignment(pair.search_source, pair.search_target, T, gate, config.threads)
             .truncated_mean;
     if (objective < best_objective) {
       best_objective = objective;
@@ -172,13 +171,13 @@ MethodOutput RunPyramid(const MethodInput& input) {
     }
   }
 
-  MethodOutput output;
+  RegistrationResult output;
   output.transform = UncentredTransform(pair.source_centre, pair.target_centre,
                                         RefineCoarseToFine({best}, pair, config).transform);
   output.evaluations = scorer.evaluations() + static_cast<int>(translations.size());
   output.source_points = pair.search_source.size();
   output.target_points = pair.search_target.size();
-  output.voxel = config.voxel;
+  output.config = config;
   return output;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
-// The registration methods the bench compares, behind one signature. Each
-// method gets the raw (perturbed) clouds and does all of its own
-// preprocessing, so its wall time covers everything it needs.
+// The registration methods the bench compares: core's, and the baselines on
+// the same interface (registration_method.hpp), each under a bench name with
+// the dataset's settings. Each gets the raw (perturbed) clouds, so its wall
+// time covers all of its preprocessing.
 
 #include <cstdint>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/config.hpp"
+#include "boicp/registration/registration_method.hpp"
 #include "boicp/util/types.hpp"
 #include "dataset_table.hpp"
 
@@ -47,20 +49,32 @@ struct MethodOutput {
 /// Every method name, in the order tables and plots list them.
 const std::vector<std::string>& MethodNames();
 
-/// Runs `name` (one of MethodNames()) on one pair. Throws what the method throws.
+/// Runs `name` (one of MethodNames()) on one pair. Throws what the method
+/// throws, and UsageError for an unknown name.
 MethodOutput RunMethod(const std::string& name, const MethodInput& input);
+
+/// bo-C with `config` as given (fields still automatic chosen from the pair).
+MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& input);
 
 /// One line per method describing its budget, for summary.md.
 std::vector<std::string> DescribeMethods(const std::vector<std::string>& names, bool quick);
 
-// The methods themselves, one file each.
-MethodOutput RunBoIcp(const std::string& preset, bool six_dof, const MethodInput& input);
-MethodOutput RunBoIcpWithConfig(const BoIcpConfig& config, const MethodInput& input);
-MethodOutput RunBoIcpAuto(const MethodInput& input);
-MethodOutput RunNaiveBoIcp(const MethodInput& input);
-MethodOutput RunIcpFromIdentity(const MethodInput& input);
-MethodOutput RunPyramid(const MethodInput& input);
-MethodOutput RunRansacFpfh(const MethodInput& input);
-MethodOutput RunFastGlobal(const MethodInput& input);
+/// core's methods (CoreMethods()) and the bench's baselines on the same
+/// interface: "naive", "icp-identity", "pyramid", "ransac-fpfh" and "fgr".
+/// The baselines prepare nothing (they keep the raw scan) so that their
+/// time covers all of their own preprocessing. `quick`: smoke-test budgets.
+MethodRegistry BenchRegistry(bool quick);
+
+// The baselines, one file each: raw clouds in, with the dataset table's settings.
+RegistrationResult RunNaiveBoIcp(const Points& source, const Points& target,
+                                 const BoIcpConfig& config, const RegistrationCallbacks& callbacks);
+RegistrationResult RunIcpFromIdentity(const Points& source, const Points& target,
+                                      const BoIcpConfig& config);
+RegistrationResult RunPyramid(const Points& source, const Points& target, const BoIcpConfig& config,
+                              bool quick);
+RegistrationResult RunRansacFpfh(const Points& source, const Points& target,
+                                 const BoIcpConfig& config, bool quick);
+RegistrationResult RunFastGlobal(const Points& source, const Points& target,
+                                 const BoIcpConfig& config);
 
 }  // namespace boicp::bench

@@ -56,6 +56,8 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
   // Before the sensor could be set, the format and the geometry chose it, as
   // "auto" still does.
   if (!config.contains("sensor")) config["sensor"] = SensorSettingName(std::nullopt);
+  // Before methods could be chosen, every pair ran BO-ICP.
+  if (!config.contains("method")) config["method"] = kDefaultMethod;
   if (!config.contains("retry_when_doubtful")) return;
   static const std::pair<const char*, const char*> kRenamed[] = {
       {"max_correspondence_distance", "max_correspondence"},

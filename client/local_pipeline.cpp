@@ -21,10 +21,6 @@ std::string JoinNames(const std::vector<std::string>& names) {
   return joined;
 }
 
-std::string PairName(const PairIndex& p) {
-  return std::to_string(p.source) + "->" + std::to_string(p.target);
-}
-
 BoIcpConfig BuildConfig(const MapSettings& s) {
   BoIcpConfig config = settings::ConfigFromSettings(s);
   // Parallelism is across pairs; inside one registration it is one thread,

@@ -11,6 +11,7 @@
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
+#include "boicp/registration/registration_method.hpp"
 #include "boicp/settings/settings_flags.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "cli_parsing.hpp"
@@ -119,8 +120,12 @@ int RunRegister(const RegisterFlags& flags) {
                      chosen.far_returns[0], chosen.far_returns[1]);
       }
     }
+    PairHints hints;
+    hints.prior = prior;
     const RegistrationResult result =
-        RegisterPair(source.points, target.points, config, prior, MakeProgressPrinter(flags.quiet));
+        CoreMethods()
+            .Create(config.method, config)
+            ->RegisterClouds(source.points, target.points, hints, MakeProgressPrinter(flags.quiet));
     if (flags.json) {
       nlohmann::json out = RegistrationToJson(result, auto_fields);
       out["far_returns"] = {{"source", chosen.far_returns[0]}, {"target", chosen.far_returns[1]}};

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "boicp/util/text.hpp"
 #include "boicp/util/types.hpp"
 #include "commands.hpp"
 #include "printable_text.hpp"
@@ -17,13 +18,6 @@ std::string ReadFileOrThrow(const std::string& path, const std::string& flag) {
   std::ostringstream bytes;
   bytes << in.rdbuf();
   return bytes.str();
-}
-
-std::string Trim(const std::string& text) {
-  const char* space = " \t\r\n";
-  const size_t begin = text.find_first_not_of(space);
-  if (begin == std::string::npos) return "";
-  return text.substr(begin, text.find_last_not_of(space) - begin + 1);
 }
 
 std::string DescribeRpcError(const rpc::RpcError& e, const RemoteFlags& flags) {

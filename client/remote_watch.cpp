@@ -7,6 +7,7 @@
 #include "boicp/mapping/batch_pair.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
+#include "duration_text.hpp"
 #include "printable_text.hpp"
 
 namespace boicp::cli {
@@ -44,20 +45,6 @@ void PrintOutcome(const v1::Job& job) {
 }
 
 }  // namespace
-
-std::string FormatDuration(double seconds) {
-  if (!(seconds >= 0.0)) return "?";
-  const long total = std::lround(seconds);
-  char text[32];
-  if (total >= 3600) {
-    std::snprintf(text, sizeof text, "%ldh%02ldm", total / 3600, total % 3600 / 60);
-  } else if (total >= 60) {
-    std::snprintf(text, sizeof text, "%ldm%02lds", total / 60, total % 60);
-  } else {
-    std::snprintf(text, sizeof text, "%lds", total);
-  }
-  return text;
-}
 
 std::string GapLine(uint32_t skipped) {
   return "watch fell behind: " + std::to_string(skipped) + " finished pair" +

@@ -50,9 +50,6 @@ std::string GapLine(uint32_t skipped);
 /// "[#####...............]": done of total in `width` characters.
 std::string ProgressBar(uint32_t done, uint32_t total, int width = 20);
 
-/// "1h02m", "3m05s", "42s"; "?" when negative.
-std::string FormatDuration(double seconds);
-
 /// Checks the job exists (a control call with a short deadline), follows
 /// WatchJob until its final state with progress on stderr, and prints the
 /// outcome there (on success also "N of M pairs doubtful"). Returns kOk when the job SUCCEEDED;

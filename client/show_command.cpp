@@ -8,6 +8,7 @@
 #include "boicp/mapping/batch_pair.hpp"
 #include "boicp/settings/rung_summary.hpp"
 #include "commands.hpp"
+#include "duration_text.hpp"
 #include "printable_text.hpp"
 #include "remote_json.hpp"
 #include "remote_options.hpp"

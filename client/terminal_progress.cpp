@@ -7,29 +7,13 @@
 #include <string>
 
 #include "cli_parsing.hpp"
+#include "duration_text.hpp"
 
 namespace boicp::cli {
 namespace {
 
 double NowSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-std::string FormatDuration(double seconds) {
-  const long s = std::lround(std::max(seconds, 0.0));
-  char text[32];
-  if (s >= 3600) {
-    std::snprintf(text, sizeof(text), "%ldh%02ldm", s / 3600, (s / 60) % 60);
-  } else if (s >= 60) {
-    std::snprintf(text, sizeof(text), "%ldm%02lds", s / 60, s % 60);
-  } else {
-    std::snprintf(text, sizeof(text), "%lds", s);
-  }
-  return text;
-}
-
-std::string PairName(const PairIndex& p) {
-  return std::to_string(p.source) + "->" + std::to_string(p.target);
 }
 
 }  // namespace

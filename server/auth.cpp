@@ -5,6 +5,8 @@
 
 #include <grpcpp/security/server_credentials.h>
 
+#include "boicp/util/text.hpp"
+
 namespace boicp::server {
 namespace {
 
@@ -14,13 +16,6 @@ std::string ReadFile(const std::string& path, const char* what) {
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
-}
-
-std::string Trim(const std::string& text) {
-  const char* space = " \t\r\n";
-  const size_t begin = text.find_first_not_of(space);
-  if (begin == std::string::npos) return "";
-  return text.substr(begin, text.find_last_not_of(space) - begin + 1);
 }
 
 // Compares in time independent of where the strings differ.

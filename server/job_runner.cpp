@@ -37,10 +37,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr auto kProgressInterval = std::chrono::seconds(1);
 
-std::string PairName(const PairIndex& p) {
-  return std::to_string(p.source) + "->" + std::to_string(p.target);
-}
-
 const char* PairingName(PairingMode pairing) {
   switch (pairing) {
     case PairingMode::kConsecutive:

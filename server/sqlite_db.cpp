@@ -89,10 +89,6 @@ void SqliteStatement::Reset() {
 
 int64_t SqliteStatement::ColumnInt(int column) const { return sqlite3_column_int64(stmt_, column); }
 
-double SqliteStatement::ColumnDouble(int column) const {
-  return sqlite3_column_double(stmt_, column);
-}
-
 std::string SqliteStatement::ColumnText(int column) const {
   const auto* text = sqlite3_column_text(stmt_, column);
   const int size = sqlite3_column_bytes(stmt_, column);

@@ -33,7 +33,6 @@ class SqliteStatement {
 
   // Columns are 0-based, as in SQLite.
   int64_t ColumnInt(int column) const;
-  double ColumnDouble(int column) const;
   std::string ColumnText(int column) const;
   std::string ColumnBlob(int column) const;
 

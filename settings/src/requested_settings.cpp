@@ -3,6 +3,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "boicp/registration/registration_method.hpp"
 #include "boicp/settings/setting_schema.hpp"
 #include "boicp/util/types.hpp"
 
@@ -23,6 +24,8 @@ void VisitOptional(const SettingField& field, Action&& action) {
 
 BoIcpConfig ConfigFromSettings(const RequestedSettings& settings) {
   BoIcpConfig config = PresetConfig(settings.preset);
+  CoreMethods().Require(settings.method);
+  config.method = settings.method;
   if (settings.fixed_settings) config.automatic.clear();
   config.mode = ParseSearchMode(settings.mode);
   config.icp_objective = ParseIcpObjective(settings.icp_objective);
@@ -48,6 +51,7 @@ BoIcpConfig ConfigFromSettings(const RequestedSettings& settings) {
 
 RequestedSettings SettingsFromConfig(const BoIcpConfig& config) {
   RequestedSettings settings;
+  settings.method = config.method;
   settings.preset = config.preset;
   settings.mode = SearchModeName(config.mode);
   settings.icp_objective = IcpObjectiveName(config.icp_objective);

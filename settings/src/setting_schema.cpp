@@ -36,6 +36,10 @@ std::vector<SettingField> BuildSchema() {
   const ProtoMessage kMapMsg = ProtoMessage::kMapSettings;
   const ProtoMessage kNone = ProtoMessage::kNone;
   return {
+      {"method", "--method", nullptr, "method", kReg, "method", kEveryFrontEnd,
+       "bo-icp (BO-ICP, as --budget says) or icp (one ICP from the prior, else the identity, "
+       "refined: for scans already close)",
+       nullptr, PlainBinding<std::string>{&RS::method}, kUnbounded},
       {"preset", "--config", nullptr, "config", kReg, "preset", kEveryFrontEnd,
        "BO-ICP preset A, B or C (the paper's)", nullptr, PlainBinding<std::string>{&RS::preset},
        kUnbounded},

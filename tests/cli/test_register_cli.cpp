@@ -224,6 +224,29 @@ TEST_F(Cli, FixedBudgetRunsThePapersSearch) {
   ExpectAttemptsAddUp(j);
 }
 
+// --method icp: one refinement from the identity, assessed like any answer.
+// The demo pair is turned beyond ICP's basin, so the answer is doubtful, as
+// it must be; the default method finds it.
+TEST_F(Cli, IcpMethodRefinesOnceAndSaysWhenItIsLost) {
+  ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
+  const std::string pair = "register --source " + (dir_ / "source.xyz").string() + " --target " +
+                           (dir_ / "target.xyz").string() + " --seed 3 --json";
+  const RunResult icp = Run(pair + " --method icp");
+  ASSERT_EQ(icp.exit_code, 0) << icp.err;
+  const nlohmann::json j = nlohmann::json::parse(icp.out);
+  EXPECT_EQ(j["config"]["method"], "icp");
+  EXPECT_EQ(j["evaluations"], 1);
+  EXPECT_EQ(j["answered_by"], "prior");
+  ASSERT_EQ(j["attempts"].size(), 1u);
+  EXPECT_EQ(j["attempts"][0]["kind"], "prior");
+  EXPECT_TRUE(j["doubtful"].get<bool>()) << j["confidence"];
+  const RunResult bo = Run(pair);
+  ASSERT_EQ(bo.exit_code, 0) << bo.err;
+  const nlohmann::json b = nlohmann::json::parse(bo.out);
+  EXPECT_EQ(b["config"]["method"], "bo-icp");
+  EXPECT_FALSE(b["doubtful"].get<bool>());
+}
+
 TEST_F(Cli, FixedSettingsAndNoRetry) {
   ASSERT_EQ(Run("demo-data --out " + dir_.string()).exit_code, 0);
   const RunResult r = Run("register --source " + (dir_ / "source.xyz").string() + " --target " +
@@ -263,6 +286,8 @@ TEST_F(Cli, BadInputGivesOneLineErrorAndExitCode2) {
       {pair + " --config Z", "preset"},
       {pair + " --budget nope", "--budget: unknown budget 'nope' (expected auto or fixed)"},
       {pair + " --mode nope", "--mode: unknown search mode 'nope' (expected nested or 6dof)"},
+      {pair + " --method ransac",
+       "--method: unknown registration method 'ransac' (known: bo-icp, icp)"},
       {pair + " --max-range 0.01", "points after cropping"},
       {pair + " --prior /nonexistent_prior.txt", "nonexistent_prior"},
   };
@@ -287,7 +312,7 @@ TEST_F(Cli, MissingRequiredFlagAndHelp) {
   for (const char* flag :
        {"--voxel", "--translation-bounds", "--rotation-bounds", "--format", "--intrinsics",
         "--intrinsics-file", "--depth-scale", "--prior", "--config", "--mode", "--seed", "--json",
-        "--fixed-settings", "--no-retry", "--budget"}) {
+        "--fixed-settings", "--no-retry", "--budget", "--method"}) {
     EXPECT_THAT(help.out, HasSubstr(flag));
   }
 }

@@ -74,6 +74,14 @@ std::vector<ScanSource> MissingScans(int n) {
   return scans;
 }
 
+// The preset's settings as final: a batch chooses its settings before it
+// registers (ApplyBatchSettings).
+BoIcpConfig FinalConfig() {
+  BoIcpConfig config;
+  config.automatic.clear();
+  return config;
+}
+
 PairExecution OnPool(ThreadPool& pool, std::function<bool()> stop = {}) {
   PairExecution execution;
   execution.submit = [&pool](std::function<void()> task) { pool.Submit(std::move(task)); };
@@ -87,7 +95,7 @@ TEST(MapPipeline, StoredPairsAreReusedAndNothingIsRegisteredAgain) {
   MemoryStore store({Finished(1, 2, 0.9), Finished(0, 1, 0.9), Finished(7, 8, 0.9)});
   RecordingProgress progress;
   const RegisteredPairs registered =
-      RegisterPlannedPairs(MissingScans(3), BoIcpConfig{}, PlanFixedPairs(ConsecutivePairs(3)),
+      RegisterPlannedPairs(MissingScans(3), FinalConfig(), PlanFixedPairs(ConsecutivePairs(3)),
                            store, progress, OnPool(pool));
   EXPECT_TRUE(store.saved_.empty());
   // In plan order; a stored pair the plan does not hold is ignored.
@@ -105,7 +113,7 @@ TEST(MapPipeline, KeyframeChainComesFromTheStoredOverlaps) {
                      Finished(3, 2, 0.9), Finished(0, 1, 0.9)});
   RecordingProgress progress;
   const RegisteredPairs registered = RegisterPlannedPairs(
-      MissingScans(4), BoIcpConfig{}, PlanKeyframes(0.7), store, progress, OnPool(pool));
+      MissingScans(4), FinalConfig(), PlanKeyframes(0.7), store, progress, OnPool(pool));
   EXPECT_TRUE(store.saved_.empty());
   EXPECT_THAT(registered.chain, ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}));
   // The probe 3 -> 0 is kept (listed), the consecutive-direction 0 -> 1 is not the plan's.
@@ -118,7 +126,7 @@ TEST(MapPipeline, AFailedPairIsReportedAndRethrownAfterTheOthersStop) {
   MemoryStore store({});
   RecordingProgress progress;
   EXPECT_THROW(
-      RegisterPlannedPairs(MissingScans(4), BoIcpConfig{}, PlanFixedPairs(ConsecutivePairs(4)),
+      RegisterPlannedPairs(MissingScans(4), FinalConfig(), PlanFixedPairs(ConsecutivePairs(4)),
                            store, progress, OnPool(pool)),
       InputError);
   ASSERT_EQ(progress.failed.size(), 1u);
@@ -131,7 +139,7 @@ TEST(MapPipeline, AStopRequestEndsRegistrationWithCancelled) {
   MemoryStore store({});
   RecordingProgress progress;
   EXPECT_THROW(
-      RegisterPlannedPairs(MissingScans(4), BoIcpConfig{}, PlanFixedPairs(ConsecutivePairs(4)),
+      RegisterPlannedPairs(MissingScans(4), FinalConfig(), PlanFixedPairs(ConsecutivePairs(4)),
                            store, progress, OnPool(pool, [] { return true; })),
       Cancelled);
   EXPECT_TRUE(progress.failed.empty());

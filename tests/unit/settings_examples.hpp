@@ -18,12 +18,13 @@ inline std::string ExampleWord(const std::string& flag) {
   if (flag == "--icp-objective") return "point";
   if (flag == "--budget") return "fixed";
   if (flag == "--sensor") return "depth";
+  if (flag == "--method") return "icp";
   return "B";
 }
 
 /// The command line that gives every setting of `frontend` a value:
-/// preset B, mode 6dof, ICP objective point, budget fixed, sensor depth,
-/// switches on,
+/// method icp, preset B, mode 6dof, ICP objective point, budget fixed,
+/// sensor depth, switches on,
 /// the n-th number field n + 0.25 (the refinement voxel 0.25, counts n + 7),
 /// bounds "0.25,0.5,1.25".
 inline std::vector<std::string> ExampleArguments(Frontend frontend) {

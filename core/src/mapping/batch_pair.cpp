@@ -9,26 +9,25 @@
 namespace boicp {
 
 BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                                  const BoIcpConfig& job_config, ScanPyramidCache& pyramids,
+                                  const BoIcpConfig& job_config, PreparedScanCache& prepared,
                                   const std::function<bool()>& stop_requested) {
-  const std::shared_ptr<const ScanPyramid> source = pyramids.Get(pair.source);
-  const std::shared_ptr<const ScanPyramid> target = pyramids.Get(pair.target);
+  const std::shared_ptr<const PreparedScan> source = prepared.Get(pair.source);
+  const std::shared_ptr<const PreparedScan> target = prepared.Get(pair.target);
 
   BoIcpConfig config = job_config;
   config.seed = PairSeed(job_config.seed, pair);
   RegistrationCallbacks callbacks;
   callbacks.stop_requested = stop_requested;
-  BatchPairResult out;
-  out.seed = config.seed;
+  PairHints hints;
+  hints.prior =
+      PairPrior(scans[static_cast<size_t>(pair.source)], scans[static_cast<size_t>(pair.target)]);
   // Scans next to each other in a batch are usually a drive's consecutive
   // scans, which ICP from identity aligns: the ladder's prior rung tries it.
-  const std::optional<Transform> guess = std::abs(pair.source - pair.target) == 1
-                                             ? std::optional<Transform>(Transform::Identity())
-                                             : std::nullopt;
-  out.registration = RegisterPair(
-      *source, *target, config,
-      PairPrior(scans[static_cast<size_t>(pair.source)], scans[static_cast<size_t>(pair.target)]),
-      callbacks, guess);
+  if (std::abs(pair.source - pair.target) == 1) hints.guess = Transform::Identity();
+  BatchPairResult out;
+  out.seed = config.seed;
+  out.registration =
+      CoreMethods().Create(config.method, config)->Register(*source, *target, hints, callbacks);
   return out;
 }
 

@@ -38,15 +38,15 @@ constexpr int kFusionWindow = 4;
 
 // One scan ready to fuse: its ray-cast cells and, when the merged cloud is
 // wanted, its points within range (scan frame).
-struct PreparedScan {
+struct ScanForFusion {
   ScanUpdate update;
   Points cloud_points;
 };
 
-PreparedScan PrepareScan(const OccupancyMap& map, const ScanSource& scan, const Transform& pose,
-                         const MapBuildSettings& settings, bool want_cloud, int threads,
-                         size_t max_update_bytes, const MapStopRequest& stop) {
-  PreparedScan prepared;
+ScanForFusion PrepareScan(const OccupancyMap& map, const ScanSource& scan, const Transform& pose,
+                          const MapBuildSettings& settings, bool want_cloud, int threads,
+                          size_t max_update_bytes, const MapStopRequest& stop) {
+  ScanForFusion prepared;
   Points points = LoadPointCloud(scan.path, scan.load).points;
   prepared.update =
       map.ComputeUpdate(points, pose, scan.sensor_origin, threads, stop, max_update_bytes);
@@ -149,14 +149,14 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
                        max_update_bytes, callbacks.stop_requested);
   };
   try {
-    std::vector<PreparedScan> current(static_cast<size_t>(window_at(0)));
+    std::vector<ScanForFusion> current(static_cast<size_t>(window_at(0)));
     ThrowIfStopped(callbacks);
     ParallelFor(current.size(), threads,
                 [&](size_t k) { current[k] = prepare(static_cast<int>(k)); });
     for (int first = 0; first < total; first += window) {
       ThrowIfStopped(callbacks);
       const int next_first = first + window;
-      std::vector<PreparedScan> next(static_cast<size_t>(window_at(next_first)));
+      std::vector<ScanForFusion> next(static_cast<size_t>(window_at(next_first)));
       ParallelFor(1 + next.size(), threads, [&](size_t task) {
         if (task > 0) {
           next[task - 1] = prepare(next_first + static_cast<int>(task) - 1);

@@ -11,10 +11,6 @@
 namespace boicp {
 namespace {
 
-std::string PairName(const PairIndex& p) {
-  return "(" + std::to_string(p.source) + " -> " + std::to_string(p.target) + ")";
-}
-
 uint64_t SplitMix64(uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -32,6 +28,10 @@ int FindRoot(std::vector<int>& parent, int i) {
 
 }  // namespace
 
+std::string PairName(const PairIndex& p) {
+  return std::to_string(p.source) + "->" + std::to_string(p.target);
+}
+
 std::vector<PairIndex> ConsecutivePairs(int num_scans) {
   std::vector<PairIndex> pairs;
   for (int i = 0; i + 1 < num_scans; ++i) pairs.push_back({i, i + 1});
@@ -44,7 +44,7 @@ void ValidatePairs(int num_scans, const std::vector<PairIndex>& pairs, bool requ
   std::iota(parent.begin(), parent.end(), 0);
   for (size_t i = 0; i < pairs.size(); ++i) {
     const PairIndex& p = pairs[i];
-    const std::string where = "pair " + std::to_string(i) + " " + PairName(p);
+    const std::string where = "pair " + std::to_string(i) + " (" + PairName(p) + ")";
     if (p.source < 0 || p.source >= num_scans || p.target < 0 || p.target >= num_scans) {
       throw InputError(where + ": scan index out of range (the batch has " +
                        std::to_string(num_scans) + " scans)");

@@ -6,6 +6,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -61,8 +62,9 @@ class PairScheduler {
         progress_(progress),
         execution_(execution),
         num_scans_(static_cast<int>(scans.size())),
+        method_(CoreMethods().Create(config.method, config)),
         // Pairs in flight share scans with the next pairs out of the queue.
-        pyramids_(scans, config, static_cast<size_t>(std::max(execution.max_in_flight, 1)) + 2) {}
+        prepared_(scans, *method_, static_cast<size_t>(std::max(execution.max_in_flight, 1)) + 2) {}
 
   RegisteredPairs Run() {
     LoadStored();
@@ -242,7 +244,7 @@ class PairScheduler {
       completion.stopped = true;
     } else {
       try {
-        const BatchPairResult result = RegisterBatchPair(scans_, pair, config_, pyramids_, stop);
+        const BatchPairResult result = RegisterBatchPair(scans_, pair, config_, prepared_, stop);
         store_.Save(pair, order, result);
         completion.finished = FinishedFromResult(pair, result);
       } catch (const Cancelled&) {
@@ -285,7 +287,8 @@ class PairScheduler {
   MapProgressSink& progress_;
   const PairExecution& execution_;
   const int num_scans_;
-  ScanPyramidCache pyramids_;  // shared by the pair tasks
+  const std::unique_ptr<const RegistrationMethod> method_;  // prepares every scan
+  PreparedScanCache prepared_;                              // shared by the pair tasks
 
   // Used on the scheduling thread only.
   std::map<PairIndex, FinishedPair> finished_;

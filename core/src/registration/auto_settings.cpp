@@ -420,4 +420,13 @@ std::string DescribeSettings(const BoIcpConfig& config, const std::vector<std::s
   return text;
 }
 
+std::vector<std::string> ChooseSettingsForPair(const Points& source, const Points& target,
+                                               BoIcpConfig& config) {
+  if (config.automatic.empty()) return {};
+  return ApplyChosenSettings(
+      ChooseSettingsForClouds({&source, &target}, DeclareSensor(config.sensor, CloudFormat::kAuto),
+                              config.seed, 2, config.threads),
+      config);
+}
+
 }  // namespace boicp

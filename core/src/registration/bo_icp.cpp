@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <utility>
@@ -335,10 +336,14 @@ namespace {
 // The registration proper, once the settings are final and both scans are
 // cropped, centred and downsampled. The engine works between the centred
 // clouds; the transforms it takes and gives are mapped at this boundary.
+// `register_centred` gets the prior and the guess between the centred clouds.
+using CentredRegistration = std::function<Registered(const std::optional<Transform>& prior,
+                                                     const std::optional<Transform>& guess)>;
+
 RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& target,
                                  const BoIcpConfig& config, const std::optional<Transform>& prior,
-                                 const RegistrationCallbacks& callbacks,
                                  const std::optional<Transform>& guess,
+                                 const CentredRegistration& register_centred,
                                  std::chrono::steady_clock::time_point started) {
   ValidateConfig(config);
   const auto centred = [&](const std::optional<Transform>& T) -> std::optional<Transform> {
@@ -348,11 +353,7 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   const auto uncentred = [&](const Transform& T) {
     return UncentredTransform(source.centre, target.centre, T);
   };
-  const std::optional<Transform> centred_prior = centred(prior);
-  Registered registered =
-      config.budget == Budget::kFixed
-          ? RegisterFixed(source, target, config, centred_prior, callbacks)
-          : Ladder(source, target, config, centred_prior, callbacks).Run(centred(guess));
+  Registered registered = register_centred(centred(prior), centred(guess));
   SearchOutcome& kept = registered.kept;
   RegistrationResult result;
   result.transform = uncentred(kept.refined.transform);
@@ -388,6 +389,24 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   return result;
 }
 
+// BO-ICP as config.budget says: the ladder or the paper's fixed search.
+RegistrationResult RegisterWithBudget(const ScanPyramid& source, const ScanPyramid& target,
+                                      const BoIcpConfig& config,
+                                      const std::optional<Transform>& prior,
+                                      const RegistrationCallbacks& callbacks,
+                                      const std::optional<Transform>& guess,
+                                      std::chrono::steady_clock::time_point started) {
+  return RegisterScans(
+      source, target, config, prior, guess,
+      [&](const std::optional<Transform>& centred_prior,
+          const std::optional<Transform>& centred_guess) {
+        return config.budget == Budget::kFixed
+                   ? RegisterFixed(source, target, config, centred_prior, callbacks)
+                   : Ladder(source, target, config, centred_prior, callbacks).Run(centred_guess);
+      },
+      started);
+}
+
 }  // namespace
 
 RegistrationResult RegisterPair(const Points& source, const Points& target,
@@ -396,18 +415,11 @@ RegistrationResult RegisterPair(const Points& source, const Points& target,
                                 const std::optional<Transform>& guess) {
   const auto started = std::chrono::steady_clock::now();
   BoIcpConfig config = requested;
-  std::vector<std::string> auto_fields;
-  if (!config.automatic.empty()) {
-    auto_fields = ApplyChosenSettings(
-        ChooseSettingsForClouds({&source, &target},
-                                DeclareSensor(config.sensor, CloudFormat::kAuto), config.seed, 2,
-                                config.threads),
-        config);
-  }
+  std::vector<std::string> auto_fields = ChooseSettingsForPair(source, target, config);
   ValidateConfig(config);
   RegistrationResult result =
-      RegisterScans(BuildScanPyramid(source, config), BuildScanPyramid(target, config), config,
-                    prior, callbacks, guess, started);
+      RegisterWithBudget(BuildScanPyramid(source, config), BuildScanPyramid(target, config), config,
+                         prior, callbacks, guess, started);
   result.auto_fields = std::move(auto_fields);
   return result;
 }
@@ -419,8 +431,32 @@ RegistrationResult RegisterPair(const ScanPyramid& source, const ScanPyramid& ta
   if (!config.automatic.empty()) {
     throw std::invalid_argument("RegisterPair on scan pyramids needs settings chosen beforehand");
   }
-  return RegisterScans(source, target, config, prior, callbacks, guess,
-                       std::chrono::steady_clock::now());
+  return RegisterWithBudget(source, target, config, prior, callbacks, guess,
+                            std::chrono::steady_clock::now());
+}
+
+RegistrationResult RefineFromStart(const ScanPyramid& source, const ScanPyramid& target,
+                                   const BoIcpConfig& config, const Transform& start,
+                                   const RegistrationCallbacks& callbacks) {
+  if (!config.automatic.empty()) {
+    throw std::invalid_argument("RefineFromStart needs settings chosen beforehand");
+  }
+  const auto started = std::chrono::steady_clock::now();
+  return RegisterScans(
+      source, target, config, start, std::nullopt,
+      [&](const std::optional<Transform>& centred_start, const std::optional<Transform>&) {
+        const auto prepared =
+            std::make_shared<const PreparedPair>(PreparePair(source, target, config));
+        const SearchFrame frame = MakeSearchFrame(*prepared, *centred_start);
+        Registered out;
+        out.kept = OutcomeOf(prepared, frame, config);
+        RefineAndAssess(out.kept, {frame.anchor}, config, callbacks);
+        out.rung = Rung::kPrior;
+        out.attempts.push_back(AttemptOf(AttemptKind::kPrior, config, out.kept, 1, 1, started));
+        out.attempts.back().kept = true;
+        return out;
+      },
+      started);
 }
 
 }  // namespace boicp

@@ -11,7 +11,7 @@
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/mapping/pose_graph.hpp"
-#include "boicp/mapping/scan_pyramid_cache.hpp"
+#include "boicp/mapping/prepared_scan_cache.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
 
@@ -22,16 +22,17 @@ struct BatchPairResult {
   uint64_t seed = 0;                // the pair's seed, PairSeed(job seed, pair)
 };
 
-/// Takes scans[pair.source] and scans[pair.target] from `pyramids` (a cache
-/// over `scans` built with `job_config`) and runs BO-ICP with `job_config`
-/// but seed PairSeed(job_config.seed, pair), centred on PairPrior when both
-/// scans have a prior pose; scans adjacent in the batch get identity as the
-/// ladder's guess (RegisterPair). job_config's settings must be final
-/// (ApplyBatchSettings). Throws Cancelled when `stop_requested` fires,
-/// InputError when a scan does not load (or an index is out of range),
+/// Takes scans[pair.source] and scans[pair.target] from `prepared` (a cache
+/// over `scans` whose method is job_config.method with job_config) and
+/// registers them with that method, with job_config but seed
+/// PairSeed(job_config.seed, pair), centred on PairPrior when both scans
+/// have a prior pose; scans adjacent in the batch get identity as the guess
+/// (PairHints). job_config's settings must be final (ApplyBatchSettings).
+/// Throws Cancelled when `stop_requested` fires, InputError when a scan does
+/// not load, an index is out of range or the method is unknown,
 /// std::runtime_error for engine failures.
 BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                                  const BoIcpConfig& job_config, ScanPyramidCache& pyramids,
+                                  const BoIcpConfig& job_config, PreparedScanCache& prepared,
                                   const std::function<bool()>& stop_requested = {});
 
 /// The finest search or refinement voxel accepted, as a fraction of the

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
@@ -24,6 +25,9 @@ struct PairIndex {
     return source != other.source ? source < other.source : target < other.target;
   }
 };
+
+/// "source->target", as logs and progress name a pair.
+std::string PairName(const PairIndex& p);
 
 /// Scan i (source) onto scan i+1 (target) for every i < num_scans - 1, the
 /// direction of the shared data's pairs.csv.
@@ -115,9 +119,6 @@ class KeyframePlanner {
 
   /// The pairs that form the chain so far (one per scan after the first).
   const std::vector<PairIndex>& ChainPairs() const { return chain_; }
-
-  /// Scans attached so far (scan 0 counts as attached).
-  int AttachedScans() const { return next_; }
 
  private:
   void Advance();

@@ -92,6 +92,13 @@ ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
 /// kAutoRegistrationFields order.
 std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcpConfig& config);
 
+/// Chooses the fields still in config.automatic from a pair's two raw clouds
+/// (the sensor as config.sensor says, else from their geometry), as
+/// RegisterPair does, and returns their names (ApplyChosenSettings). Throws
+/// InputError for clouds too small to choose from.
+std::vector<std::string> ChooseSettingsForPair(const Points& source, const Points& target,
+                                               BoIcpConfig& config);
+
 /// One line for the user: preset, search mode, the sensor and why, and the
 /// voxel, refinement voxel and boxes, each marked "(auto)" when in
 /// `auto_fields`.

@@ -163,4 +163,14 @@ RegistrationResult RegisterPair(const ScanPyramid& source, const ScanPyramid& ta
                                 const RegistrationCallbacks& callbacks = {},
                                 const std::optional<Transform>& guess = std::nullopt);
 
+/// ICP alone: one refinement from `start` (T_target_source) through the
+/// pyramid's levels, its answer assessed like every other (confidence,
+/// fitness, information), for scans already close to aligned. Answered by
+/// Rung::kPrior with one attempt and one evaluation. Throws
+/// std::invalid_argument when config.automatic is not empty, InputError for
+/// an invalid config, and Cancelled when stop_requested fires.
+RegistrationResult RefineFromStart(const ScanPyramid& source, const ScanPyramid& target,
+                                   const BoIcpConfig& config, const Transform& start,
+                                   const RegistrationCallbacks& callbacks = {});
+
 }  // namespace boicp

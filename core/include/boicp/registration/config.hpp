@@ -66,7 +66,14 @@ extern const std::vector<std::string> kAutoRegistrationFields;
 /// still wraps around.
 Eigen::Vector3d SnapRotationBounds(const Eigen::Vector3d& bounds);
 
+/// The registration method front ends use unless told otherwise
+/// (registration_method.hpp).
+inline constexpr const char* kDefaultMethod = "bo-icp";
+
 struct BoIcpConfig {
+  /// The registration method, by its name in the registry (CoreMethods());
+  /// the fields below are its settings.
+  std::string method = kDefaultMethod;
   std::string preset = "C";  // name of the preset these values started from
   /// Fields still to be chosen from the clouds (names from
   /// kAutoRegistrationFields); their values below are the preset's fixed ones

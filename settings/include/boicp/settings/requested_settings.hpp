@@ -19,6 +19,7 @@ namespace boicp::settings {
 /// when BoIcpConfig::automatic (or MapAutoFields) lists them.
 struct RequestedSettings {
   // --- Registration --------------------------------------------------------
+  std::string method = kDefaultMethod;  // a name in CoreMethods(): bo-icp | icp
   std::string preset = "C";             // the paper's A, B or C (case-insensitive)
   std::string mode = "nested";          // nested | 6dof
   std::string icp_objective = "plane";  // plane | point: the search evaluations' ICP

@@ -1,4 +1,4 @@
-#include "boicp/mapping/scan_pyramid_cache.hpp"
+#include "boicp/mapping/prepared_scan_cache.hpp"
 
 #include <algorithm>
 #include <string>
@@ -7,11 +7,11 @@
 
 namespace boicp {
 
-ScanPyramidCache::ScanPyramidCache(const std::vector<ScanSource>& scans, const BoIcpConfig& config,
-                                   size_t capacity)
-    : scans_(scans), config_(config), capacity_(std::max<size_t>(capacity, 1)) {}
+PreparedScanCache::PreparedScanCache(const std::vector<ScanSource>& scans,
+                                     const RegistrationMethod& method, size_t capacity)
+    : scans_(scans), method_(method), capacity_(std::max<size_t>(capacity, 1)) {}
 
-std::shared_ptr<const ScanPyramid> ScanPyramidCache::Get(int index) {
+std::shared_ptr<const PreparedScan> PreparedScanCache::Get(int index) {
   if (index < 0 || index >= static_cast<int>(scans_.size())) {
     throw InputError("pair index " + std::to_string(index) + " is outside the batch of " +
                      std::to_string(scans_.size()) + " scans");
@@ -31,13 +31,11 @@ std::shared_ptr<const ScanPyramid> ScanPyramidCache::Get(int index) {
     entry = recent_.front().second;
   }
   std::lock_guard<std::mutex> building(entry->building);
-  if (!entry->pyramid) {
-    ValidateConfig(config_);  // its voxels and range limits shape the pyramid
+  if (!entry->prepared) {
     const ScanSource& scan = scans_[static_cast<size_t>(index)];
-    entry->pyramid = std::make_shared<const ScanPyramid>(
-        BuildScanPyramid(LoadPointCloud(scan.path, scan.load).points, config_));
+    entry->prepared = method_.Prepare(LoadPointCloud(scan.path, scan.load).points);
   }
-  return entry->pyramid;
+  return entry->prepared;
 }
 
 }  // namespace boicp

@@ -1,0 +1,12 @@
+#pragma once
+// Small text helpers shared by the daemon, the CLI and the bench.
+
+#include <string>
+
+namespace boicp {
+
+/// `text` without leading and trailing spaces, tabs, carriage returns and
+/// line feeds (a line read from a token file or /proc).
+std::string Trim(const std::string& text);
+
+}  // namespace boicp

@@ -1,0 +1,12 @@
+#include "boicp/util/text.hpp"
+
+namespace boicp {
+
+std::string Trim(const std::string& text) {
+  const char* space = " \t\r\n";
+  const size_t begin = text.find_first_not_of(space);
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(space) - begin + 1);
+}
+
+}  // namespace boicp
