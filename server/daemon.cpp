@@ -39,6 +39,9 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   RequireStorage(*data_dir_, min_free_bytes);
   store_ = std::make_unique<JobStore>(data_dir_->DatabasePath());
   watches_ = std::make_unique<WatchHub>();
+  if (options_.max_decode_mb > 0) {
+    decode_budget_ = std::make_unique<DecodeBudget>(options_.max_decode_mb << 20);
+  }
   ManagerOptions manager_options;
   manager_options.workers = options_.workers;
   manager_options.concurrent_jobs = options_.concurrent_jobs;
@@ -52,13 +55,15 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_options.max_stored_bytes = max_stored_bytes;
   manager_options.max_fusion_bytes = static_cast<size_t>(options_.max_fusion_mb << 20);
   manager_options.max_job_seconds = options_.max_job_seconds;
+  manager_options.decode_budget = decode_budget_.get();
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
                                             options_.max_upload_bytes_in_flight);
   idle_uploads_ = std::make_unique<IdleUploads>(std::chrono::seconds(options_.upload_idle_s));
-  service_ = std::make_unique<MapBuilderService>(ServiceDeps{
-      *store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *idle_uploads_,
-      options_.max_scan_bytes, options_.max_scan_points, min_free_bytes, max_stored_bytes});
+  service_ = std::make_unique<MapBuilderService>(
+      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *idle_uploads_,
+                  options_.max_scan_bytes, options_.max_scan_points, min_free_bytes,
+                  max_stored_bytes, decode_budget_.get()});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -88,10 +93,11 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
                data_dir_->root());
   spdlog::info(
       "limits: {} queued jobs, {} scans a batch, {} bytes a message, {} bytes and {} "
-      "points a scan; {} MiB kept free; {} MiB of fusion and {} s a job (0 = no limit)",
+      "points a scan; {} MiB kept free; {} MiB of fusion and {} s a job; {} MiB decoding "
+      "(0 = no limit)",
       options_.max_queued_jobs, options_.max_batch_scans, options_.max_message_bytes,
       options_.max_scan_bytes, options_.max_scan_points, options_.min_free_mb,
-      options_.max_fusion_mb, options_.max_job_seconds);
+      options_.max_fusion_mb, options_.max_job_seconds, options_.max_decode_mb);
   spdlog::info("auth {}, TLS {}", auth_.enabled() ? "on" : "off",
                options_.tls_cert.empty()        ? "off"
                : options_.tls_client_ca.empty() ? "on"
@@ -117,6 +123,8 @@ bool Daemon::Shutdown() {
         options_.shutdown_grace_s);
   }
   watches_->CloseAll(grpc::Status(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down"));
+  // Uploads waiting for decoding memory end now rather than hold the drain.
+  if (decode_budget_) decode_budget_->Close();
   server_->Shutdown(deadline);
   server_->Wait();
   try {

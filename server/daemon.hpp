@@ -8,6 +8,7 @@
 #include <grpcpp/server.h>
 
 #include "auth.hpp"
+#include "boicp/io/decode_budget.hpp"
 #include "daemon_options.hpp"
 #include "data_dir.hpp"
 #include "idle_uploads.hpp"
@@ -46,6 +47,7 @@ class Daemon {
   std::unique_ptr<DataDir> data_dir_;
   std::unique_ptr<JobStore> store_;
   std::unique_ptr<WatchHub> watches_;
+  std::unique_ptr<DecodeBudget> decode_budget_;  // null with --max-decode-mb 0; outlives its users
   std::unique_ptr<JobManager> manager_;
   std::unique_ptr<UploadBudget> uploads_;
   std::unique_ptr<IdleUploads> idle_uploads_;  // outlives the server: its uploads leave it

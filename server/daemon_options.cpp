@@ -54,6 +54,14 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "passes it fails (0 = no limit)")
       ->capture_default_str()
       ->envname("BOICPD_MAX_FUSION_MB");
+  app.add_option("--max-decode-mb", o.max_decode_mb,
+                 "MiB the scans decoding at once may take, uploads and jobs together (each "
+                 "scan's bound from its header); a decode that does not fit waits, and a scan "
+                 "whose bound is over it is RESOURCE_EXHAUSTED at upload. The default fits a "
+                 "2 GiB pod beside fusion and gRPC, and the largest scan the other limits admit "
+                 "(5 M points of 64 bytes, about 440 MiB) still decodes (0 = no limit)")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_DECODE_MB");
   app.add_option("--max-job-seconds", o.max_job_seconds,
                  "Seconds a job may run before it fails (0 = no deadline)")
       ->capture_default_str()
@@ -186,6 +194,7 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
           "--scan-grace-hours must be in 0..1000000");
   require(o.max_stored_gb >= 0.0 && o.max_stored_gb <= 1e7, "--max-stored-gb must be in 0..1e7");
   require(o.max_fusion_mb <= (uint64_t{1} << 40), "--max-fusion-mb must be at most 2^40");
+  require(o.max_decode_mb <= (uint64_t{1} << 40), "--max-decode-mb must be at most 2^40");
   require(o.max_job_seconds >= 0.0 && o.max_job_seconds <= 1e9,
           "--max-job-seconds must be in 0..1e9");
   require(o.tls_cert.empty() == o.tls_key.empty(), "--tls-cert and --tls-key go together");

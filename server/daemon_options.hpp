@@ -24,6 +24,7 @@ struct DaemonOptions {
   double scan_grace_hours = 24.0;  // scans no job uses are deleted this long after their last use
   double max_stored_gb = 0.0;      // scans and outputs; uploads over it are refused; 0 = no cap
   uint64_t max_fusion_mb = 0;      // one job's fusion; AddDaemonOptions sets half the memory
+  uint64_t max_decode_mb = 512;    // scans decoding at once, uploads and jobs together; 0 = none
   double max_job_seconds = 172800.0;  // a running job fails past it; 0 = no deadline
   int max_concurrent_uploads = 8;
   uint64_t max_upload_bytes_in_flight = 1ull << 30;  // announced by the uploads streaming at once

@@ -26,9 +26,9 @@ JobManager::JobManager(JobStore& store, DataDir& data_dir, JobEventSink& events,
                        const ManagerOptions& options)
     : store_(store), data_dir_(data_dir), events_(events), options_(options) {
   pool_ = std::make_unique<ThreadPool>(options_.workers);
-  context_ = std::make_unique<RunnerContext>(
-      RunnerContext{store_, data_dir_, *pool_, events_, options_.registration_threads,
-                    options_.workers, options_.max_fusion_bytes, options_.max_job_seconds});
+  context_ = std::make_unique<RunnerContext>(RunnerContext{
+      store_, data_dir_, *pool_, events_, options_.registration_threads, options_.workers,
+      options_.max_fusion_bytes, options_.max_job_seconds, options_.decode_budget});
 }
 
 JobManager::~JobManager() { Drain(); }

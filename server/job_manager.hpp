@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "boicp/io/decode_budget.hpp"
 #include "boicp/util/thread_pool.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
@@ -34,10 +35,11 @@ struct ManagerOptions {
   uint64_t max_scan_points = 5000000;  // points per stored scan; more is RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;  // below it (or unwritable) new batches are FAILED_PRECONDITION
   double retain_seconds = 0.0;  // finished jobs older than this are deleted; 0 = kept for good
-  double scan_grace_seconds = 86400.0;  // scans no job uses go this long after their last use
-  uint64_t max_stored_bytes = 0;        // scans and outputs; 0 = no cap
-  size_t max_fusion_bytes = 0;          // one job's fusion memory; 0 = no limit
-  double max_job_seconds = 0.0;         // a running job fails past it; 0 = no deadline
+  double scan_grace_seconds = 86400.0;    // scans no job uses go this long after their last use
+  uint64_t max_stored_bytes = 0;          // scans and outputs; 0 = no cap
+  size_t max_fusion_bytes = 0;            // one job's fusion memory; 0 = no limit
+  double max_job_seconds = 0.0;           // a running job fails past it; 0 = no deadline
+  DecodeBudget* decode_budget = nullptr;  // shared with the uploads; null = no budget
 };
 
 class JobManager {

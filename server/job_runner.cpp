@@ -98,6 +98,13 @@ class JobRun : public MapProgressSink {
     if (!input) throw std::runtime_error("the job's input is missing from the data store");
     batch_spec_ = BuildJobSpec(job_.job_id(), input->request, input->scans, ctx_.data_dir,
                                ctx_.registration_threads);
+    // Every load of the job's scans (settings, pairs, fusion) shares the
+    // daemon's decode budget with the uploads, and stops waiting for it
+    // when the job stops.
+    for (ScanSource& scan : batch_spec_.scans) {
+      scan.load.decode_budget = ctx_.decode_budget;
+      scan.load.decode_stop = [this] { return control_.StopRequested(); };
+    }
     VerifyScans();
     // Chosen once from the job's scans; a resumed job chooses the same again.
     const BatchSettingsChoice choice = ApplyBatchSettings(

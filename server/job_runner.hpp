@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstddef>
 
+#include "boicp/io/decode_budget.hpp"
 #include "boicp/util/thread_pool.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
@@ -23,9 +24,10 @@ struct RunnerContext {
   ThreadPool& pool;
   JobEventSink& events;
   int registration_threads = 1;
-  int max_pairs_in_flight = 1;   // per job, so concurrent jobs share the pool
-  size_t max_fusion_bytes = 0;   // one job's fusion memory; 0 = no limit
-  double max_job_seconds = 0.0;  // from the job's first start; 0 = no deadline
+  int max_pairs_in_flight = 1;            // per job, so concurrent jobs share the pool
+  size_t max_fusion_bytes = 0;            // one job's fusion memory; 0 = no limit
+  double max_job_seconds = 0.0;           // from the job's first start; 0 = no deadline
+  DecodeBudget* decode_budget = nullptr;  // every scan the job decodes; null = no budget
 };
 
 /// Stop requests for a running job, shared by the manager, the runner and

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "auth.hpp"
+#include "boicp/io/decode_budget.hpp"
 #include "boicp/v1/map_builder.grpc.pb.h"
 #include "data_dir.hpp"
 #include "idle_uploads.hpp"
@@ -30,6 +31,7 @@ struct ServiceDeps {
   uint64_t max_scan_points = 0;   // scans decoding to more points are RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;    // below it uploads and batches are FAILED_PRECONDITION
   uint64_t max_stored_bytes = 0;  // scans and outputs; more is RESOURCE_EXHAUSTED; 0 = no cap
+  DecodeBudget* decode_budget = nullptr;  // shared with the job workers; null = no budget
 };
 
 /// The freshest view of a job: the newest published snapshot, else the store.

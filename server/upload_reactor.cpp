@@ -36,11 +36,15 @@ void RequirePointLimit(uint64_t points, uint64_t limit) {
 }
 
 // The loaders refuse a scan over the limit from its header, before they
-// allocate its points.
+// allocate its points. With a decode budget the load waits, on this gRPC
+// thread, until the scan's decoding bound fits beside the other decodes (the
+// returned cloud holds its share); a scan that could never fit is refused.
 LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& metadata,
-                             uint64_t max_points) {
+                             const ServiceDeps& deps, grpc::CallbackServerContext* context) {
   LoadOptions options = rpc::LoadOptionsFromMetadata(metadata);
-  options.max_points = max_points;
+  options.max_points = deps.max_scan_points;
+  options.decode_budget = deps.decode_budget;
+  options.decode_stop = [context] { return context->IsCancelled(); };
   try {
     return LoadPointCloud(path, options);
   } catch (const PointLimitError& e) {
@@ -48,6 +52,12 @@ LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& me
     throw;
   } catch (const InputError& e) {
     throw InputError(WithoutPath(e.what(), path));
+  } catch (const LimitExceeded& e) {
+    throw LimitExceeded(WithoutPath(e.what(), path));
+  } catch (const Cancelled&) {
+    throw ServiceError(grpc::StatusCode::UNAVAILABLE,
+                       "the upload stopped waiting for decoding memory (--max-decode-mb): "
+                       "it was cancelled or boicpd is shutting down");
   }
 }
 
@@ -61,7 +71,7 @@ bool SameDecoding(const v1::ScanMetadata& a, const v1::ScanMetadata& b) {
 
 UploadReactor::UploadReactor(const ServiceDeps& deps, grpc::CallbackServerContext* context,
                              v1::UploadScanResponse* response, const grpc::Status& auth)
-    : deps_(deps), response_(response) {
+    : deps_(deps), context_(context), response_(response) {
   if (!auth.ok()) {
     FinishUpload(auth);
     return;
@@ -201,8 +211,8 @@ void UploadReactor::Complete() {
     uint64_t points = stored.num_points;
     RangeProfile ranges = stored.ranges;
     if (!SameDecoding(metadata, stored.metadata) || ranges.empty()) {
-      const LoadedCloud cloud = LoadUploadedScan(deps_.data_dir.ScanPath(metadata.sha256()),
-                                                 metadata, deps_.max_scan_points);
+      const LoadedCloud cloud =
+          LoadUploadedScan(deps_.data_dir.ScanPath(metadata.sha256()), metadata, deps_, context_);
       points = cloud.points.size();
       ranges = ProfileRanges(cloud.points);
     }
@@ -231,7 +241,7 @@ void UploadReactor::Complete() {
   if (!metadata.sha256().empty() && metadata.sha256() != id) {
     throw InputError("metadata.sha256 does not match the bytes received (got " + id + ")");
   }
-  const LoadedCloud cloud = LoadUploadedScan(temp_path_, metadata, deps_.max_scan_points);
+  const LoadedCloud cloud = LoadUploadedScan(temp_path_, metadata, deps_, context_);
   const bool present = deps_.data_dir.HasScanFile(id);
   if (!present) {
     deps_.data_dir.CommitScan(temp_path_, id);

@@ -50,6 +50,7 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   bool StoredCopyIntact(const std::string& scan_id);
 
   const ServiceDeps& deps_;
+  grpc::CallbackServerContext* context_;  // polled for a cancel while decoding waits
   ::boicp::v1::UploadScanResponse* response_;
   ::boicp::v1::UploadScanRequest request_;
   std::optional<::boicp::v1::ScanMetadata> metadata_;

@@ -45,6 +45,13 @@ std::ifstream OpenOrThrow(const std::string& path, std::ios::openmode mode) {
   return in;
 }
 
+uint64_t FileSizeOrThrow(const std::string& path) {
+  std::error_code ec;
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
+  return static_cast<uint64_t>(size);
+}
+
 std::vector<std::string_view> SplitFields(std::string_view line) {
   std::vector<std::string_view> fields;
   size_t pos = 0;

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 
 #include <open3d/geometry/Image.h>
 #include <open3d/io/ImageIO.h>
@@ -58,27 +57,27 @@ uint64_t BigEndianU32(const unsigned char* bytes) {
          uint64_t{bytes[3]};
 }
 
+}  // namespace
+
 // Open3D allocates the whole image from the PNG header before decoding it, so
 // a 100-byte file declaring 65535 x 65535 pixels costs 8 GB. Deflate expands
 // at most 1032-fold, so a header whose pixels cannot come from the file's
 // bytes is refused here, as is one over kMaxDepthPixels. Anything that is not
 // a PNG header is left to Open3D's own error.
-void RequirePlausiblePngSize(const std::string& path, uint64_t max_points) {
+std::optional<PngLayout> RequirePlausiblePngSize(const std::string& path, uint64_t max_points) {
   constexpr uint64_t kDeflateMaxExpansion = 1032;
   constexpr uint64_t kMaxDepthPixels = uint64_t{1} << 26;  // 64 Mpx, 8192 x 8192
   static const unsigned char kSignature[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   std::ifstream in = OpenOrThrow(path, std::ios::in | std::ios::binary);
   unsigned char head[26] = {};
-  if (!in.read(reinterpret_cast<char*>(head), sizeof(head))) return;
-  if (std::memcmp(head, kSignature, sizeof(kSignature)) != 0) return;
-  if (std::memcmp(head + 12, "IHDR", 4) != 0) return;
+  if (!in.read(reinterpret_cast<char*>(head), sizeof(head))) return std::nullopt;
+  if (std::memcmp(head, kSignature, sizeof(kSignature)) != 0) return std::nullopt;
+  if (std::memcmp(head + 12, "IHDR", 4) != 0) return std::nullopt;
   const uint64_t width = BigEndianU32(head + 16);
   const uint64_t height = BigEndianU32(head + 20);
   const uint64_t bit_depth = head[24];
   const uint64_t channels = head[25] == 2 ? 3 : head[25] == 4 ? 2 : head[25] == 6 ? 4 : 1;
-  std::error_code ec;
-  const uint64_t file_size = std::filesystem::file_size(path, ec);
-  if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
+  const uint64_t file_size = FileSizeOrThrow(path);
   const std::string size = std::to_string(width) + " x " + std::to_string(height);
   if (width * height > kMaxDepthPixels) {
     throw InputError(path + ": depth PNG of " + size + " pixels is over the 64-megapixel limit");
@@ -88,7 +87,10 @@ void RequirePlausiblePngSize(const std::string& path, uint64_t max_points) {
                      std::to_string(file_size) + " bytes)");
   }
   RequirePointCount(path, width * height, max_points);  // a point per pixel at most
+  return PngLayout{width, height, channels, bit_depth};
 }
+
+namespace {
 
 open3d::geometry::Image ReadSixteenBitGrey(const std::string& path, uint64_t max_points) {
   RequirePlausiblePngSize(path, max_points);

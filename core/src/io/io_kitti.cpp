@@ -2,7 +2,6 @@
 
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 
 #include "io/io_readers.hpp"
 
@@ -28,9 +27,7 @@ float LittleEndianFloat(const unsigned char* bytes) {
 
 Points ReadKittiBin(const std::string& path, uint64_t max_points) {
   std::ifstream in = OpenOrThrow(path, std::ios::in | std::ios::binary);
-  std::error_code ec;
-  const uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
+  const uint64_t size = FileSizeOrThrow(path);
   if (size == 0) throw InputError(path + ": empty KITTI .bin");
   if (size % kBytesPerRow != 0) {
     throw InputError(path + ": truncated KITTI .bin (" + std::to_string(size) +

@@ -10,7 +10,7 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <optional>
@@ -130,7 +130,7 @@ uint64_t ReadHeaderLines(const std::string& path, PcdHeader* header) {
     next_keyword = index + 1;
     header->lines[keyword].assign(tokens.begin() + 1, tokens.end());
     if (keyword != "DATA") continue;
-    if (in.eof()) return static_cast<uint64_t>(std::filesystem::file_size(path));
+    if (in.eof()) return FileSizeOrThrow(path);
     return static_cast<uint64_t>(in.tellg());
   }
   Fail(path, "no DATA line in the first " + std::to_string(kMaxHeaderLines) + " lines");
@@ -222,15 +222,13 @@ void RequireAsciiPointLines(const std::string& path, const PcdHeader& header,
   }
 }
 
-// Every size the header declares must fit in the `available` bytes after it.
-void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t data_offset,
-                     uint64_t available) {
+// Every size the header declares must fit in the `available` bytes after it;
+// returns the compressed bytes of binary_compressed data (0 otherwise).
+uint64_t RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t data_offset,
+                         uint64_t available) {
   const uint64_t declared = header.points * header.point_bytes;
   if (declared > kMaxDataBytes) Fail(path, "POINTS x point size is over 2 GB");
-  if (header.data == "ascii") {
-    RequireAsciiPointLines(path, header, data_offset);
-    return;
-  }
+  if (header.data == "ascii") return 0;
   if (header.point_bytes > kMaxBinaryPointBytes) {
     Fail(path, "binary points of " + std::to_string(header.point_bytes) + " bytes; at most " +
                    std::to_string(kMaxBinaryPointBytes) +
@@ -241,7 +239,7 @@ void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t 
       throw InputError(path + ": truncated PCD (" + std::to_string(declared) +
                        " data bytes declared, " + std::to_string(available) + " present)");
     }
-    return;
+    return 0;
   }
   std::ifstream in = OpenOrThrow(path, std::ios::in | std::ios::binary);
   in.seekg(static_cast<std::streamoff>(data_offset));
@@ -263,21 +261,50 @@ void RequireDataFits(const std::string& path, const PcdHeader& header, uint64_t 
                    std::to_string(uncompressed / std::max<uint64_t>(compressed, 1)) +
                    " times; at most " + std::to_string(kMaxCompressedExpansion) + " is accepted");
   }
+  return compressed;
+}
+
+bool HasField(const PcdHeader& header, std::initializer_list<const char*> names) {
+  return std::any_of(header.fields.begin(), header.fields.end(), [&](const PcdField& f) {
+    return std::find(names.begin(), names.end(), f.name) != names.end();
+  });
+}
+
+// The header checked up to the data, which ascii files still need checked.
+PcdHeader ReadCheckedHeader(const std::string& path, uint64_t max_points, PcdLayout* layout,
+                            uint64_t* data_offset) {
+  PcdHeader header;
+  *data_offset = ReadHeaderLines(path, &header);
+  const uint64_t file_size = FileSizeOrThrow(path);
+  ParseFields(path, &header);
+  ParseSizes(path, &header);
+  RequireDecodableXyz(path, header);
+  layout->compressed_bytes = RequireDataFits(path, header, *data_offset, file_size - *data_offset);
+  RequirePointCount(path, header.points, max_points);
+  layout->points = header.points;
+  layout->point_bytes = header.point_bytes;
+  layout->ascii = header.data == "ascii";
+  layout->compressed = header.data == "binary_compressed";
+  // Open3D sizes normals and colours to POINTS when the header names them.
+  layout->normals = HasField(header, {"normal_x", "normal_y", "normal_z"});
+  layout->colors = HasField(header, {"rgb", "rgba"});
+  return header;
 }
 
 }  // namespace
 
+PcdLayout ReadPcdLayout(const std::string& path, uint64_t max_points) {
+  PcdLayout layout;
+  uint64_t data_offset = 0;
+  ReadCheckedHeader(path, max_points, &layout, &data_offset);
+  return layout;
+}
+
 void RequireSafePcdHeader(const std::string& path, uint64_t max_points) {
-  PcdHeader header;
-  const uint64_t data_offset = ReadHeaderLines(path, &header);
-  std::error_code ec;
-  const uintmax_t file_size = std::filesystem::file_size(path, ec);
-  if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
-  ParseFields(path, &header);
-  ParseSizes(path, &header);
-  RequireDecodableXyz(path, header);
-  RequireDataFits(path, header, data_offset, static_cast<uint64_t>(file_size) - data_offset);
-  RequirePointCount(path, header.points, max_points);
+  PcdLayout layout;
+  uint64_t data_offset = 0;
+  const PcdHeader header = ReadCheckedHeader(path, max_points, &layout, &data_offset);
+  if (layout.ascii) RequireAsciiPointLines(path, header, data_offset);
 }
 
 }  // namespace boicp::io_detail

@@ -9,7 +9,6 @@
 // would mean changing global state.
 
 #include <algorithm>
-#include <filesystem>
 #include <map>
 #include <optional>
 #include <string_view>
@@ -57,6 +56,8 @@ bool IsPlyPropertyLine(const std::vector<std::string_view>& w) {
   return w.size() == 5 && w[1] == "list" && IsPlyScalarType(w[2]) && IsPlyScalarType(w[3]);
 }
 
+}  // namespace
+
 // Open3D resizes the cloud to the declared vertex count before RPly reads a
 // vertex ("element vertex 2000000000" in a 200-byte file costs 48 GB), and
 // RPly itself crashed on headers the fuzzer made up (a comment cut off by the
@@ -64,7 +65,7 @@ bool IsPlyPropertyLine(const std::vector<std::string_view>& w) {
 // line by line against the PLY grammar, every line whole (RPly reads words
 // across line ends), and the vertex count may not exceed the bytes after the
 // header, since a vertex takes at least one.
-void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
+PlyLayout RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
   constexpr size_t kMaxHeaderLines = 1000;
   constexpr size_t kMaxHeaderLine = 1000;  // RPly's words and lines have fixed buffers
   const auto fail = [&path](const std::string& why) {
@@ -76,6 +77,7 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
   if (!line.empty() && line.back() == '\r') line.pop_back();
   if (line != "ply") fail("first line is not 'ply'");
   std::optional<uint64_t> vertices;
+  PlyLayout layout;
   bool ascii = false;
   bool in_element = false;
   bool in_vertex = false;
@@ -93,9 +95,7 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
     if (n == 2) ascii = words[1] == "ascii";
     if (n == 2 || words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
     if (words[0] == "end_header" && words.size() == 1) {
-      std::error_code ec;
-      const uint64_t size = std::filesystem::file_size(path, ec);
-      if (ec) throw InputError(path + ": cannot get file size (" + ec.message() + ")");
+      const uint64_t size = FileSizeOrThrow(path);
       const uint64_t data = in.eof() ? 0 : size - static_cast<uint64_t>(in.tellg());
       if (vertices && *vertices > data / std::max<uint64_t>(vertex_bytes, 1)) {
         throw InputError(path + ": truncated PLY (" + std::to_string(*vertices) +
@@ -103,10 +103,16 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
                          " bytes declared, " + std::to_string(data) + " data bytes)");
       }
       if (vertices) RequirePointCount(path, *vertices, max_points);
-      return;
+      layout.vertices = vertices.value_or(0);
+      return layout;
     }
     if (words[0] == "property" && in_element && IsPlyPropertyLine(words)) {
-      if (in_vertex) vertex_bytes += ascii ? 2 : PlyScalarBytes(words[words.size() == 3 ? 1 : 2]);
+      if (!in_vertex) continue;
+      vertex_bytes += ascii ? 2 : PlyScalarBytes(words[words.size() == 3 ? 1 : 2]);
+      const std::string_view name = words.back();
+      // Open3D sizes normals and colours to the vertex count when it finds them.
+      layout.normals = layout.normals || name == "nx" || name == "ny" || name == "nz";
+      layout.colors = layout.colors || name == "red" || name == "green" || name == "blue";
       continue;
     }
     const std::optional<double> count =
@@ -121,10 +127,8 @@ void RequirePlyHeaderFits(const std::string& path, uint64_t max_points) {
     if (vertices) fail("two vertex elements");
     vertices = static_cast<uint64_t>(*count);
   }
-  fail("no end_header line");
+  throw InputError(path + ": bad PLY header (no end_header line)");
 }
-
-}  // namespace
 
 Points ReadPcdOrPly(const std::string& path, CloudFormat format, uint64_t max_points) {
   const bool is_ply = format == CloudFormat::kPly;

@@ -18,6 +18,9 @@ namespace boicp::io_detail {
 /// unless `path` can be opened for reading.
 void RequireReadableFile(const std::string& path);
 
+/// The size of `path` in bytes, or InputError naming it and the reason.
+uint64_t FileSizeOrThrow(const std::string& path);
+
 /// Opens `path` or throws InputError naming it and the OS reason.
 std::ifstream OpenOrThrow(const std::string& path, std::ios::openmode mode = std::ios::in);
 
@@ -44,10 +47,51 @@ std::vector<double> ReadNumbersFile(const std::string& path);
 /// Throws PointLimitError when `points` is over `max_points`.
 void RequirePointCount(const std::string& path, uint64_t points, uint64_t max_points);
 
+/// What a checked PCD header declares, as far as Open3D's allocations go.
+struct PcdLayout {
+  uint64_t points = 0;
+  uint64_t point_bytes = 0;       // the sum of the fields' SIZE x COUNT
+  uint64_t compressed_bytes = 0;  // binary_compressed only
+  bool ascii = false;
+  bool compressed = false;  // binary_compressed
+  bool normals = false;     // Open3D fills normals as well as points
+  bool colors = false;      // and colours
+};
+
 /// Throws InputError unless `path` has a PCD v0.7 header whose declared
 /// sizes fit the file and whose x/y/z Open3D decodes (see io_pcd_header.cpp),
-/// and PointLimitError when it declares more than `max_points` points.
+/// and PointLimitError when it declares more than `max_points` points. Reads
+/// the header and the compressed sizes only, not the points.
+PcdLayout ReadPcdLayout(const std::string& path, uint64_t max_points);
+
+/// ReadPcdLayout's checks, and for ascii data, that every point has its line.
 void RequireSafePcdHeader(const std::string& path, uint64_t max_points);
+
+/// What a checked PLY header declares, as far as Open3D's allocations go.
+struct PlyLayout {
+  uint64_t vertices = 0;
+  bool normals = false;  // Open3D sizes normals as well as points to the vertex count
+  bool colors = false;   // and colours
+};
+
+/// Throws InputError unless `path` has a PLY header RPly and Open3D read
+/// safely, whose vertices fit in the bytes after it (see io_pcd_ply.cpp), and
+/// PointLimitError over `max_points` vertices.
+PlyLayout RequirePlyHeaderFits(const std::string& path, uint64_t max_points);
+
+/// A PNG's IHDR, when the file starts with one.
+struct PngLayout {
+  uint64_t width = 0, height = 0;
+  uint64_t channels = 1, bit_depth = 8;
+};
+
+/// Throws InputError when a PNG header declares more pixels than the file's
+/// bytes can hold or than 64 megapixels, PointLimitError over `max_points`
+/// pixels; nullopt for a file that is not a PNG (Open3D then refuses it).
+std::optional<PngLayout> RequirePlausiblePngSize(const std::string& path, uint64_t max_points);
+
+/// Lines of a text file that hold data (neither blank nor '#' comments).
+uint64_t CountDataLines(const std::string& path);
 
 // Each reader refuses more than `max_points` points before allocating them.
 Points ReadKittiBin(const std::string& path, uint64_t max_points);

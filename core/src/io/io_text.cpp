@@ -89,7 +89,8 @@ void AppendNumber(double value, std::string* out) {
   out->append(buffer, result.ptr);
 }
 
-// Lines holding data (not blank, not '#'), read one at a time.
+}  // namespace
+
 uint64_t CountDataLines(const std::string& path) {
   std::ifstream in = OpenOrThrow(path);
   uint64_t count = 0;
@@ -101,8 +102,6 @@ uint64_t CountDataLines(const std::string& path) {
   if (in.bad()) throw InputError(path + ": read error");
   return count;
 }
-
-}  // namespace
 
 Points ReadXyzText(const std::string& path, uint64_t max_points) {
   // Text declares no count: the lines are counted before any point is kept.

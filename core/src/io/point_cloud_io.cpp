@@ -110,6 +110,14 @@ LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options) 
   io_detail::RequireReadableFile(path);
   LoadedCloud cloud;
   cloud.format = options.format == CloudFormat::kAuto ? DetectCloudFormat(path) : options.format;
+  if (options.decode_budget != nullptr) {
+    const uint64_t bound = DecodeBoundBytes(path, options);
+    try {
+      cloud.decode_lease = options.decode_budget->Acquire(bound, options.decode_stop);
+    } catch (const LimitExceeded& e) {
+      throw LimitExceeded(path + ": " + e.what());
+    }
+  }
   cloud.points = ReadPoints(path, cloud.format, options);
   const size_t total = cloud.points.size();
   cloud.dropped_nonfinite = DropNonFinite(&cloud.points);

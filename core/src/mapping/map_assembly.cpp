@@ -47,7 +47,9 @@ ScanForFusion PrepareScan(const OccupancyMap& map, const ScanSource& scan, const
                           const MapBuildSettings& settings, bool want_cloud, int threads,
                           size_t max_update_bytes, const MapStopRequest& stop) {
   ScanForFusion prepared;
-  Points points = LoadPointCloud(scan.path, scan.load).points;
+  // Kept whole so that its share of a decode budget lasts the ray casting.
+  const LoadedCloud loaded = LoadPointCloud(scan.path, scan.load);
+  const Points& points = loaded.points;
   prepared.update =
       map.ComputeUpdate(points, pose, scan.sensor_origin, threads, stop, max_update_bytes);
   if (want_cloud) {

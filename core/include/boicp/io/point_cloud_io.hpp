@@ -5,10 +5,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "boicp/io/decode_budget.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -54,6 +56,14 @@ struct LoadOptions {
   /// More points than this (as the header declares them, or as counted for
   /// text) is refused before the points are allocated.
   uint64_t max_points = kDefaultMaxPoints;
+  /// The process's decoding memory, shared with other loads; null: none.
+  /// When set, LoadPointCloud takes DecodeBoundBytes from it before it
+  /// decodes (waiting while other loads hold it) and the cloud it returns
+  /// holds that share until the cloud is destroyed. Must outlive the cloud.
+  DecodeBudget* decode_budget = nullptr;
+  /// Polled while waiting for decode_budget; true -> boicp::Cancelled. May
+  /// be empty (then a load waits until the bytes are free or the budget closes).
+  std::function<bool()> decode_stop;
 };
 
 /// A file that declares more points than LoadOptions::max_points.
@@ -71,12 +81,25 @@ struct LoadedCloud {
   Points points;                            // finite points only, in the sensor frame, metres
   size_t dropped_nonfinite = 0;             // NaN / inf points removed while loading
   CloudFormat format = CloudFormat::kAuto;  // the format actually used
+  /// The cloud's share of LoadOptions::decode_budget (empty without one):
+  /// keep the cloud, or move the lease, for as long as its points are kept.
+  DecodeBudget::Lease decode_lease;
 };
+
+/// An upper bound, in bytes, on what LoadPointCloud(path, options) allocates
+/// while it decodes (format buffers and the point arrays), from the file's
+/// header or size alone; nothing is decoded (a text file's lines are counted).
+/// Throws what LoadPointCloud throws for the header: InputError for a missing
+/// or malformed file, PointLimitError over options.max_points.
+uint64_t DecodeBoundBytes(const std::string& path, const LoadOptions& options = {});
 
 /// Loads one cloud. Throws PointLimitError over options.max_points, checked
 /// against the header before anything is allocated. Throws InputError when the file is missing or
 /// unreadable, the format is unknown or malformed (truncated .bin, bad PLY header, PNG that is not
-/// 16-bit single channel), depth options are missing, or no finite point is left.
+/// 16-bit single channel), depth options are missing, or no finite point is left. With a
+/// decode budget: LimitExceeded (naming the file and --max-decode-mb) when the file's
+/// DecodeBoundBytes is over the whole budget, Cancelled when options.decode_stop fires or the
+/// budget closes while the load waits.
 LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options = {});
 
 /// Reads a rigid transform from a text file holding 12 (3x4, row-major) or 16
