@@ -80,6 +80,34 @@ Rung RungOfFile(const json& value) {
   return *rung;
 }
 
+// null for unknown.
+template <typename T>
+std::optional<T> OptionalOf(const json& value) {
+  if (value.is_null()) return std::nullopt;
+  return value.get<T>();
+}
+
+// Pair files without a "format" (written before there was one) lack the
+// keys added since: they read as unknown (doubtful, overlap, search_reach),
+// the full search (answered_by, as every pair was before the ladder) and the
+// settings under today's names. Files of a later format are refused, not
+// misread.
+void MigratePairFile(json& j, const std::string& path) {
+  const int format = j.value("format", 0);
+  if (format > kPairFileFormat) {
+    throw NewerPairFileError(path + ": format " + std::to_string(format) +
+                             " is newer than this boicp reads (" + std::to_string(kPairFileFormat) +
+                             "); use the boicp that wrote it");
+  }
+  if (format == kPairFileFormat) return;
+  for (const char* key : {"doubtful", "overlap", "search_reach"}) {
+    if (!j.contains(key)) j[key] = nullptr;
+  }
+  if (!j.contains("answered_by")) j["answered_by"] = RungName(Rung::kFullSearch);
+  UpgradeOldPairConfig(j.at("settings").at("config"), path);
+  j["format"] = kPairFileFormat;
+}
+
 }  // namespace
 
 json PairSettings(const std::vector<ScanSource>& scans, const PairIndex& pair,
@@ -158,6 +186,7 @@ void WritePairFile(const std::string& out_dir, const PairRecord& record) {
   }
   out["information"] = information;
   out["settings"] = record.settings;
+  out["format"] = kPairFileFormat;
   WriteTextFileAtomically(PairFilePath(out_dir, record.pair), out.dump(1) + "\n");
 }
 
@@ -166,7 +195,8 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
   std::ifstream in(path);
   if (!in) return std::nullopt;
   try {
-    const json j = json::parse(in);
+    json j = json::parse(in);
+    MigratePairFile(j, path);
     PairRecord r;
     r.pair = {j.at("source").get<int>(), j.at("target").get<int>()};
     if (!(r.pair == pair))
@@ -179,15 +209,10 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
     r.fitness = j.at("fitness").get<double>();
     r.inlier_rmse = j.at("inlier_rmse").get<double>();
     r.confidence = j.at("confidence").get<double>();
-    // Files from before these keys existed stay readable: unknown, not doubtful.
-    if (j.contains("doubtful")) r.doubtful = j.at("doubtful").get<bool>();
-    if (j.contains("overlap") && !j.at("overlap").is_null()) {
-      r.overlap = j.at("overlap").get<double>();
-    }
-    if (j.contains("search_reach") && !j.at("search_reach").is_null()) {
-      r.search_reach = j.at("search_reach").get<double>();
-    }
-    if (j.contains("answered_by")) r.answered_by = RungOfFile(j.at("answered_by"));
+    r.doubtful = OptionalOf<bool>(j.at("doubtful"));
+    r.overlap = OptionalOf<double>(j.at("overlap"));
+    r.search_reach = OptionalOf<double>(j.at("search_reach"));
+    r.answered_by = RungOfFile(j.at("answered_by"));
     r.evaluations = j.at("evaluations").get<int>();
     r.runtime_s = j.at("runtime_s").get<double>();
     r.seed = j.at("seed").get<uint64_t>();
@@ -198,8 +223,9 @@ std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairInd
       }
     }
     r.settings = j.at("settings");
-    UpgradeOldPairConfig(r.settings.at("config"), path);
     return r;
+  } catch (const NewerPairFileError&) {
+    throw;
   } catch (const std::exception& e) {
     throw InputError(path + ": not a pair result file (" + e.what() + ")");
   }

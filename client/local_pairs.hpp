@@ -46,6 +46,17 @@ nlohmann::json PairSettings(const std::vector<ScanSource>& scans, const PairInde
 PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex& pair,
                           const BatchPairResult& result, nlohmann::json settings);
 
+/// The format every pair file is written in ("format"); files without one
+/// are read through a migration (ReadPairFile).
+constexpr int kPairFileFormat = 1;
+
+/// A pair file of a format newer than kPairFileFormat: kept, never
+/// overwritten, and reported.
+class NewerPairFileError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// "OUTDIR/pairs/000003-000004.json".
 std::string PairFilePath(const std::string& out_dir, const PairIndex& pair);
 
@@ -53,9 +64,11 @@ std::string PairFilePath(const std::string& out_dir, const PairIndex& pair);
 void WritePairFile(const std::string& out_dir, const PairRecord& record);
 
 /// The stored record, or nullopt when there is no file. Throws InputError
-/// naming the file when it exists but does not parse. Files written before
-/// the budget existed ran the full search: their config reads as budget
-/// "fixed", and their answer as the full search's.
+/// naming the file when it exists but does not parse, and
+/// NewerPairFileError when it is of a format newer than kPairFileFormat. Files without a format are
+/// migrated as they are read: those written before the budget existed ran the full search, so their
+/// config reads as budget "fixed" and their answer as the full search's; keys they lack read as
+/// unknown.
 std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairIndex& pair);
 
 /// The JSON of pairs.json entries: source, target, source_path,

@@ -52,6 +52,8 @@ std::vector<FinishedPair> PairFileStore::LoadFinished() {
     std::optional<PairRecord> record;
     try {
       record = ReadPairFile(out_dir_, *pair);
+    } catch (const NewerPairFileError&) {
+      throw;  // a newer boicp's answer: not ours to overwrite
     } catch (const InputError&) {
       continue;  // unreadable: registered again and overwritten
     }

@@ -124,12 +124,28 @@ JobStore::JobStore(const std::string& path) : db_(path) {
   db_.Exec("PRAGMA synchronous=FULL");
   db_.Exec("PRAGMA foreign_keys=ON");
   db_.Exec(kSchema);
-  // Columns added since the first release; older rows read their defaults:
-  // no unended runs, answered by the full search, as every pair was before
-  // the escalation ladder, and no range profile.
+  Migrate();
+}
+
+void JobStore::Migrate() {
+  auto read = db_.Prepare("PRAGMA user_version");
+  const int64_t version = read.Step() ? read.ColumnInt(0) : 0;
+  if (version > kSchemaVersion) {
+    throw std::runtime_error("data store: its schema version " + std::to_string(version) +
+                             " is newer than this boicpd reads (" + std::to_string(kSchemaVersion) +
+                             "); run the boicpd that wrote it, or use another --data-dir");
+  }
+  if (version == kSchemaVersion) return;
+  SqliteDatabase::Transaction transaction(db_);
+  // Version 0: databases from before the version was recorded, which may
+  // lack the columns added since the first release. Older rows read their
+  // defaults: no unended runs, answered by the full search, as every pair
+  // was before the escalation ladder, and no range profile.
   AddMissingColumn("jobs", "unended_runs", "INTEGER NOT NULL DEFAULT 0");
   AddMissingColumn("pair_results", "answered_by", "TEXT NOT NULL DEFAULT 'full-search'");
   AddMissingColumn("scans", "range_profile", "BLOB NOT NULL DEFAULT x''");
+  db_.Exec("PRAGMA user_version = " + std::to_string(kSchemaVersion));
+  transaction.Commit();
 }
 
 void JobStore::AddMissingColumn(const std::string& table, const std::string& column,

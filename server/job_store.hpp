@@ -44,9 +44,16 @@ struct JobPage {
   std::string next_page_token;
 };
 
+/// The schema version the job store writes (SQLite's user_version). A
+/// database of an older version is migrated when opened; a newer one is
+/// refused.
+constexpr int kSchemaVersion = 1;
+
 class JobStore {
  public:
-  /// Opens or creates the database and its schema. Throws std::runtime_error.
+  /// Opens or creates the database and its schema, migrating an older
+  /// schema version. Throws std::runtime_error, also for a database of a
+  /// schema version newer than kSchemaVersion.
   explicit JobStore(const std::string& path);
 
   void PutScan(const v1::ScanMetadata& metadata, uint64_t num_points, const RangeProfile& ranges);
@@ -107,6 +114,9 @@ class JobStore {
  private:
   /// Adds `column` (its SQL `definition`) to `table` unless it is there:
   /// databases written before it existed open with its default.
+  // Brings a database of an older schema version to kSchemaVersion, in one
+  // transaction; refuses one of a newer version.
+  void Migrate();
   void AddMissingColumn(const std::string& table, const std::string& column,
                         const std::string& definition);
   int ReadUnendedRuns(const std::string& job_id);

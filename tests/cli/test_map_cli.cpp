@@ -178,11 +178,13 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   EXPECT_THAT(RungLine(pairs), ::testing::MatchesRegex("[0-9]+ [a-z]+(, [0-9]+ [a-z]+)*"));
   EXPECT_EQ(LastLine(first.err), RungLine(pairs)) << first.err;
 
-  // Files written before the marks existed load as trusted, overlap and
-  // reach unknown, answered by the full search; a file marked doubtful is
-  // counted as such.
+  // Files written before the marks existed (and before files had a format)
+  // load as trusted, overlap and reach unknown, answered by the full search;
+  // a file marked doubtful is counted as such.
   for (const char* name : {"000000-000001.json", "000001-000002.json"}) {
+    EXPECT_EQ(json::parse(Slurp(out / "pairs" / name))["format"], 1);
     EditPairFile(out / "pairs" / name, [](json& j) {
+      j.erase("format");
       j.erase("doubtful");
       j.erase("overlap");
       j.erase("search_reach");
@@ -228,6 +230,7 @@ json OlderPairConfig(const json& config) {
   old.erase("no_retry");
   old.erase("icp_objective");  // point-to-point was the only one
   old.erase("budget");         // the full search was the only one
+  old.erase("method");         // BO-ICP was the only one
   old["finish_icp_iterations"] = 5;
   old["refine_max_iterations"] = 60;
   old["refine_candidates"] = 3;
@@ -246,6 +249,7 @@ TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
   const std::string trajectory = Slurp(out / "trajectory.kitti");
   for (const char* name : {"000000-000001.json", "000001-000002.json", "000002-000003.json"}) {
     EditPairFile(out / "pairs" / name, [](json& j) {
+      j.erase("format");
       j["settings"]["config"] = OlderPairConfig(j["settings"]["config"]);
     });
   }
@@ -260,6 +264,14 @@ TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
   EXPECT_TRUE(kept["settings"]["config"].contains("retry_when_doubtful")) << "rewritten";
   const json redone = json::parse(Slurp(out / "pairs" / "000002-000003.json"));
   EXPECT_TRUE(redone["settings"]["config"].contains("no_retry")) << "not registered again";
+
+  // A file of a format newer than this boicp reads is refused, not misread.
+  EXPECT_EQ(redone["format"], 1);
+  EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) { j["format"] = 2; });
+  const RunResult newer = Run(args);
+  EXPECT_EQ(newer.exit_code, 2) << newer.err;
+  EXPECT_THAT(newer.err, HasSubstr("000002-000003.json"));
+  EXPECT_THAT(newer.err, HasSubstr("format 2 is newer than this boicp reads (1)"));
 }
 
 TEST_F(MapCli, GeneratedDriveWritesEveryOutputAndRerunsReusePairs) {

@@ -1,6 +1,7 @@
 // A database written before the job store's later columns existed (a job's
-// unended runs, the rung that answered a pair) still opens: its rows read
-// the columns' defaults, and new rows carry their own values.
+// unended runs, the rung that answered a pair) still opens, is brought to
+// the current schema version, and its rows read the columns' defaults; a
+// database of a newer version is refused.
 
 #include <unistd.h>
 
@@ -67,6 +68,12 @@ void WriteFirstReleaseDatabase(const std::string& path) {
       .Run();
 }
 
+int64_t UserVersion(const std::string& path) {
+  SqliteDatabase db(path);
+  auto read = db.Prepare("PRAGMA user_version");
+  return read.Step() ? read.ColumnInt(0) : -1;
+}
+
 class JobStoreMigration : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -98,6 +105,7 @@ TEST_F(JobStoreMigration, AFirstReleaseDatabaseOpensWithTheColumnsDefaults) {
     store.PutPair(kJobId, 1, next, InformationMatrix::Identity());
   }
   // Opened again: the columns are there now, and each row keeps its rung.
+  EXPECT_EQ(UserVersion(path_), kSchemaVersion);
   JobStore store(path_);
   const std::vector<StoredPair> pairs = store.GetPairs(kJobId);
   ASSERT_EQ(pairs.size(), 2u);
@@ -121,6 +129,27 @@ TEST_F(JobStoreMigration, AResultWithoutARungIsStoredAsTheFullSearch) {
   EXPECT_EQ(pairs[0].result.answered_by(), "full-search");
   EXPECT_EQ(pairs[1].result.answered_by(), "retry");
   EXPECT_FALSE(pairs[1].result.in_graph());
+}
+
+// A database written by a later boicpd (a higher schema version) is refused
+// with both versions named, and left as it was.
+TEST_F(JobStoreMigration, ADatabaseOfANewerSchemaIsRefusedAndLeftAsItWas) {
+  { JobStore created(path_); }
+  {
+    SqliteDatabase db(path_);
+    db.Exec("PRAGMA user_version = " + std::to_string(kSchemaVersion + 1));
+  }
+  try {
+    JobStore store(path_);
+    FAIL() << "a newer database was opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("schema version " + std::to_string(kSchemaVersion + 1) +
+                                         " is newer than this boicpd reads (" +
+                                         std::to_string(kSchemaVersion) + ")"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(UserVersion(path_), kSchemaVersion + 1);
 }
 
 }  // namespace
