@@ -263,6 +263,29 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_EQ(Lines(Slurp(dir_ / "t.tum")).size(), 4u);
 }
 
+// --method reaches the daemon's job: with icp each neighbouring pair is one
+// refinement from the identity, and the drive still comes out right.
+TEST_F(RemoteCli, TheIcpMethodReachesTheDaemonsJob) {
+  StartDaemon();
+  const std::vector<boicp::Transform> truth = WriteDrive(dir_ / "drive", 4, 11);
+  const std::string job =
+      SubmitAndWait((dir_ / "drive").string() + kQuick + " --resolution 0.3 --method icp");
+  const RunResult show = Run("show " + job + " --json" + server_);
+  ASSERT_EQ(show.exit_code, 0) << show.err;
+  const nlohmann::json j = nlohmann::json::parse(show.out);
+  EXPECT_EQ(j["settings"]["method"], "icp");
+  ASSERT_EQ(j["pairs"].size(), 3u);
+  for (const auto& pair : j["pairs"]) {
+    EXPECT_EQ(pair["answered_by"], "prior") << pair.dump();
+    EXPECT_EQ(pair["evaluations"], 1);
+    const int s = pair["source"], t = pair["target"];
+    const boicp::Transform expected = truth[t].inverse() * truth[s];
+    for (int row = 0; row < 3; ++row) {
+      EXPECT_NEAR(pair["transform"][row][3].get<double>(), expected(row, 3), 0.1);
+    }
+  }
+}
+
 TEST_F(RemoteCli, CancelStopsAJobWatchExitsOneAndHealthServes) {
   StartDaemon();
   const RunResult health = Run("health" + server_);
@@ -352,6 +375,8 @@ TEST_F(RemoteCli, UnknownJobAndBadInputGiveOneLineErrors) {
       {"submit " + (dir_ / "good").string() + " --config Z", "unknown preset 'Z'"},
       {"submit " + (dir_ / "good").string() + " --budget nope",
        "--budget: unknown budget 'nope' (expected auto or fixed)"},
+      {"submit " + (dir_ / "good").string() + " --method ransac",
+       "--method: unknown registration method 'ransac' (known: bo-icp, icp)"},
       {"submit " + (dir_ / "good").string() + " --rotation-bounds 1,2", "--rotation-bounds"},
       {"submit " + (dir_ / "good").string() + " --pairing sideways", "--pairing"},
       {"export job-000001 --format gif", "--format"},
