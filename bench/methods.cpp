@@ -2,7 +2,8 @@
 
 #include <chrono>
 #include <functional>
-#include <optional>
+#include <memory>
+#include <stdexcept>
 #include <utility>
 
 #include "bench_options.hpp"

@@ -333,12 +333,14 @@ std::string AttemptKindName(AttemptKind kind) {
 
 namespace {
 
+// A registration between the centred clouds: it gets the prior and the
+// guess mapped there.
+using CentredRegistration = std::function<Registered(const std::optional<Transform>& prior,
+                                                     const std::optional<Transform>& guess)>;
+
 // The registration proper, once the settings are final and both scans are
 // cropped, centred and downsampled. The engine works between the centred
 // clouds; the transforms it takes and gives are mapped at this boundary.
-// `register_centred` gets the prior and the guess between the centred clouds.
-using CentredRegistration = std::function<Registered(const std::optional<Transform>& prior,
-                                                     const std::optional<Transform>& guess)>;
 
 RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& target,
                                  const BoIcpConfig& config, const std::optional<Transform>& prior,
