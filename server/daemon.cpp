@@ -38,7 +38,7 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   const auto max_stored_bytes = static_cast<uint64_t>(options_.max_stored_gb * 1e9);
   RequireStorage(*data_dir_, min_free_bytes);
   store_ = std::make_unique<JobStore>(data_dir_->DatabasePath());
-  watches_ = std::make_unique<WatchHub>();
+  watches_ = std::make_unique<WatchHub>(options_.max_watch_streams);
   if (options_.max_decode_mb > 0) {
     decode_budget_ = std::make_unique<DecodeBudget>(options_.max_decode_mb << 20);
   }
@@ -59,9 +59,13 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   manager_ = std::make_unique<JobManager>(*store_, *data_dir_, *watches_, manager_options);
   uploads_ = std::make_unique<UploadBudget>(options_.max_concurrent_uploads,
                                             options_.max_upload_bytes_in_flight);
-  idle_uploads_ = std::make_unique<IdleUploads>(std::chrono::seconds(options_.upload_idle_s));
+  UploadWatchdog::Limits pace;
+  pace.idle_timeout = std::chrono::seconds(options_.upload_idle_s);
+  pace.min_bytes_per_s = options_.min_upload_kib_per_s << 10;
+  pace.rate_grace = std::chrono::seconds(options_.upload_rate_grace_s);
+  upload_watchdog_ = std::make_unique<UploadWatchdog>(pace);
   service_ = std::make_unique<MapBuilderService>(
-      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *idle_uploads_,
+      ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *upload_watchdog_,
                   options_.max_scan_bytes, options_.max_scan_points, min_free_bytes,
                   max_stored_bytes, decode_budget_.get()});
 

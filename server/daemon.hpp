@@ -11,10 +11,10 @@
 #include "boicp/io/decode_budget.hpp"
 #include "daemon_options.hpp"
 #include "data_dir.hpp"
-#include "idle_uploads.hpp"
 #include "job_manager.hpp"
 #include "job_store.hpp"
 #include "service.hpp"
+#include "upload_watchdog.hpp"
 #include "watch_hub.hpp"
 
 namespace boicp::server {
@@ -50,7 +50,7 @@ class Daemon {
   std::unique_ptr<DecodeBudget> decode_budget_;  // null with --max-decode-mb 0; outlives its users
   std::unique_ptr<JobManager> manager_;
   std::unique_ptr<UploadBudget> uploads_;
-  std::unique_ptr<IdleUploads> idle_uploads_;  // outlives the server: its uploads leave it
+  std::unique_ptr<UploadWatchdog> upload_watchdog_;  // outlives the server: its uploads leave it
   std::unique_ptr<MapBuilderService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::string address_;

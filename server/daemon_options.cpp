@@ -101,6 +101,21 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
                  "Seconds an upload may send nothing before it is cancelled")
       ->capture_default_str()
       ->envname("BOICPD_UPLOAD_IDLE_TIMEOUT");
+  app.add_option("--min-upload-kib-per-s", o.min_upload_kib_per_s,
+                 "KiB/s an upload must average once --upload-rate-grace has passed (counted "
+                 "from its start, less the grace); slower uploads end with DEADLINE_EXCEEDED "
+                 "(0 = no minimum)")
+      ->capture_default_str()
+      ->envname("BOICPD_MIN_UPLOAD_KIB_PER_S");
+  app.add_option("--upload-rate-grace", o.upload_rate_grace_s,
+                 "Seconds an upload may take before --min-upload-kib-per-s applies")
+      ->capture_default_str()
+      ->envname("BOICPD_UPLOAD_RATE_GRACE");
+  app.add_option("--max-watch-streams", o.max_watch_streams,
+                 "WatchJob streams open at once, all clients together; more is "
+                 "RESOURCE_EXHAUSTED")
+      ->capture_default_str()
+      ->envname("BOICPD_MAX_WATCH_STREAMS");
   app.add_option("--retain-days", o.retain_days,
                  "Delete succeeded, failed and cancelled jobs (records and outputs, not scans) "
                  "this many days after they end; 0 keeps them until boicp delete")
@@ -207,6 +222,12 @@ void ValidateDaemonOptions(const DaemonOptions& o) {
   require(o.keepalive_s >= 1 && o.keepalive_timeout_s >= 1 && o.idle_connection_s >= 1,
           "--keepalive, --keepalive-timeout and --idle-connection must be at least 1 s");
   require(o.upload_idle_s >= 1, "--upload-idle-timeout must be at least 1 s");
+  require(o.min_upload_kib_per_s <= (uint64_t{1} << 20),
+          "--min-upload-kib-per-s must be at most 1048576 (1 GiB/s)");
+  require(o.upload_rate_grace_s >= 0 && o.upload_rate_grace_s <= 86400,
+          "--upload-rate-grace must be in 0..86400 s");
+  require(o.max_watch_streams >= 1 && o.max_watch_streams <= 1000000,
+          "--max-watch-streams must be in 1..1000000");
   RequireClosedExposure(o);
   const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error", "critical"};
   require(std::find(levels.begin(), levels.end(), o.log_level) != levels.end(),

@@ -33,10 +33,13 @@ struct DaemonOptions {
   int keepalive_s = 60;                              // ping an idle connection this often
   int keepalive_timeout_s = 20;                      // and close it when the ping is not answered
   int idle_connection_s = 600;                       // close a connection with no call this long
-  int upload_idle_s = 60;         // cancel an upload that sends nothing this long
-  std::string auth_token_file;    // --token-file (alias --auth-token-file)
-  bool insecure_no_auth = false;  // serve a non-loopback address without a token
-  bool insecure = false;          // accept a token over plaintext on a non-loopback address
+  int upload_idle_s = 60;              // cancel an upload that sends nothing this long
+  uint64_t min_upload_kib_per_s = 64;  // an upload's average rate past the grace; 0 = none
+  int upload_rate_grace_s = 10;        // seconds before the rate is checked
+  int max_watch_streams = 256;         // WatchJob streams open at once, all clients together
+  std::string auth_token_file;         // --token-file (alias --auth-token-file)
+  bool insecure_no_auth = false;       // serve a non-loopback address without a token
+  bool insecure = false;               // accept a token over plaintext on a non-loopback address
   std::string tls_cert, tls_key;
   std::string tls_client_ca;      // require client certificates signed by this CA (mutual TLS)
   double shutdown_grace_s = 5.0;  // how long SIGTERM waits for open calls

@@ -9,10 +9,10 @@
 #include "boicp/io/decode_budget.hpp"
 #include "boicp/v1/map_builder.grpc.pb.h"
 #include "data_dir.hpp"
-#include "idle_uploads.hpp"
 #include "job_manager.hpp"
 #include "job_store.hpp"
 #include "upload_budget.hpp"
+#include "upload_watchdog.hpp"
 #include "watch_hub.hpp"
 
 namespace boicp::server {
@@ -26,7 +26,7 @@ struct ServiceDeps {
   WatchHub& watches;
   const BearerAuth& auth;
   UploadBudget& uploads;
-  IdleUploads& idle_uploads;
+  UploadWatchdog& upload_watchdog;
   uint64_t max_scan_bytes = 0;    // larger uploads are RESOURCE_EXHAUSTED
   uint64_t max_scan_points = 0;   // scans decoding to more points are RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;    // below it uploads and batches are FAILED_PRECONDITION

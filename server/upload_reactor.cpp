@@ -76,19 +76,25 @@ UploadReactor::UploadReactor(const ServiceDeps& deps, grpc::CallbackServerContex
     FinishUpload(auth);
     return;
   }
-  idle_id_ = deps_.idle_uploads.Enter(context);
+  watch_id_ = deps_.upload_watchdog.Enter(context);
   StartRead(&request_);
 }
 
 void UploadReactor::OnReadDone(bool ok) {
-  if (ok) deps_.idle_uploads.Touch(idle_id_);
-  if (!ok && deps_.idle_uploads.TimedOut(idle_id_)) {
-    const auto seconds =
-        std::chrono::duration_cast<std::chrono::seconds>(deps_.idle_uploads.timeout()).count();
-    FinishUpload(grpc::Status(
-        grpc::StatusCode::DEADLINE_EXCEEDED,
-        "the upload sent nothing for " + std::to_string(seconds) + " s (--upload-idle-timeout)"));
-    return;
+  if (ok) {
+    const std::string over = deps_.upload_watchdog.Touch(watch_id_, request_.chunk().size());
+    if (!over.empty()) {
+      spdlog::warn("{}: ended", over);
+      FinishUpload(grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, over));
+      return;
+    }
+  } else {
+    const std::string cancelled = deps_.upload_watchdog.CancelReason(watch_id_);
+    if (!cancelled.empty()) {
+      FinishUpload(grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, cancelled));
+      return;
+    }
+    deps_.upload_watchdog.Sent(watch_id_);
   }
   const grpc::Status status = GuardRpc("UploadScan", [&] {
     if (ok) {
@@ -100,8 +106,16 @@ void UploadReactor::OnReadDone(bool ok) {
   });
   if (!status.ok()) {
     FinishUpload(status);
-  } else if (ok) {
+  } else if (ok && !known_) {
     StartRead(&request_);
+  } else if (ok) {
+    // The daemon holds the bytes the metadata names: answer now rather than
+    // hold a slot while the client sends bytes that would not be read.
+    deps_.upload_watchdog.Sent(watch_id_);
+    FinishUpload(GuardRpc("UploadScan", [&] {
+      Complete();
+      return grpc::Status::OK;
+    }));
   } else {
     FinishUpload(grpc::Status::OK);
   }
@@ -113,7 +127,7 @@ void UploadReactor::FinishUpload(const grpc::Status& status) {
 }
 
 void UploadReactor::OnDone() {
-  if (idle_id_ != 0) deps_.idle_uploads.Leave(idle_id_);
+  if (watch_id_ != 0) deps_.upload_watchdog.Leave(watch_id_);
   if (temp_.is_open()) temp_.close();
   if (!temp_path_.empty()) {
     std::error_code ignored;
@@ -187,7 +201,6 @@ bool UploadReactor::StoredCopyIntact(const std::string& scan_id) {
 
 void UploadReactor::AcceptChunk(const std::string& bytes) {
   if (!metadata_) throw InputError("the first upload message must carry metadata");
-  if (known_) return;  // the server has these bytes already
   if (received_ + bytes.size() > metadata_->size_bytes()) {
     throw InputError("more bytes than metadata.size_bytes (" +
                      std::to_string(metadata_->size_bytes()) + ")");

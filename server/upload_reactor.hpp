@@ -5,7 +5,9 @@
 // then renamed to its hash and recorded. Refused (FAILED_PRECONDITION) while
 // the data directory cannot take the announced bytes with those of the other
 // uploads in flight, and (RESOURCE_EXHAUSTED) over the upload budget, which
-// an upload reusing stored bytes is charged their size in too.
+// an upload reusing stored bytes is charged their size in too. An upload
+// that goes silent or sends slower than the minimum rate ends (see
+// UploadWatchdog), so a slot is never held for long by a slow client.
 
 #include <fstream>
 #include <optional>
@@ -23,8 +25,10 @@ struct ServiceDeps;
 
 class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequest> {
  public:
-  /// Finishes at once with `auth` unless it is OK; otherwise the upload is
-  /// cancelled once it sends nothing for deps.idle_uploads' timeout.
+  /// Finishes at once with `auth` unless it is OK; otherwise the upload ends
+  /// with DEADLINE_EXCEEDED (or is cancelled) once it sends nothing for the
+  /// idle timeout or falls behind the minimum rate (deps.upload_watchdog).
+  /// An upload naming a stored hash is answered right after its metadata.
   UploadReactor(const ServiceDeps& deps, grpc::CallbackServerContext* context,
                 ::boicp::v1::UploadScanResponse* response, const grpc::Status& auth);
 
@@ -61,7 +65,7 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   std::ofstream temp_;
   rpc::Sha256 hash_;
   uint64_t received_ = 0;
-  uint64_t idle_id_ = 0;  // in deps_.idle_uploads; 0 = not timed
+  uint64_t watch_id_ = 0;  // in deps_.upload_watchdog; 0 = not timed
 };
 
 }  // namespace boicp::server

@@ -38,6 +38,7 @@ class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
     }
     std::lock_guard<std::mutex> lock(hub_.mutex_);
     done = true;
+    --hub_.open_streams_;
     Wake();
   }
 
@@ -63,7 +64,7 @@ class WatchHub::Stream : public grpc::ServerWriteReactor<v1::JobEvent> {
   grpc::Status status;
 };
 
-WatchHub::WatchHub() : pump_([this] { Pump(); }) {}
+WatchHub::WatchHub(int max_streams) : max_streams_(max_streams), pump_([this] { Pump(); }) {}
 
 WatchHub::~WatchHub() {
   CloseAll(grpc::Status(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down"));
@@ -115,7 +116,17 @@ grpc::ServerWriteReactor<v1::JobEvent>* WatchHub::StartWatch(const std::string& 
     stream->Finish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "boicpd is shutting down"));
     return stream;
   }
+  if (open_streams_ >= max_streams_) {
+    stream->Finish(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                std::to_string(open_streams_) +
+                                    " WatchJob streams are open, this daemon's limit "
+                                    "(--max-watch-streams " +
+                                    std::to_string(max_streams_) +
+                                    "); poll GetJob, or watch once a stream ends"));
+    return stream;
+  }
   stream->registered = true;
+  ++open_streams_;
   v1::JobEvent first;
   *first.mutable_job() = *snapshot;
   stream->pending.Push(first);

@@ -23,7 +23,8 @@ namespace v1 = ::boicp::v1;
 
 class WatchHub : public JobEventSink {
  public:
-  WatchHub();
+  /// `max_streams` >= 1: streams open at once, all jobs and clients together.
+  explicit WatchHub(int max_streams);
   /// Ends every stream with UNAVAILABLE, waits until gRPC has released
   /// them, and joins the pump. Shut the gRPC server down first.
   ~WatchHub() override;
@@ -39,7 +40,9 @@ class WatchHub : public JobEventSink {
   /// A reactor for one WatchJob call. Its first event is the newest
   /// snapshot (or `stored` when nothing was published for the job); without
   /// either it finishes with NOT_FOUND. It ends with OK after the first event
-  /// with a final state.
+  /// with a final state. With max_streams already open it finishes with
+  /// RESOURCE_EXHAUSTED: each stream holds a queue and a gRPC call for as
+  /// long as its job runs, so watchers alone could otherwise exhaust memory.
   grpc::ServerWriteReactor<v1::JobEvent>* StartWatch(const std::string& job_id,
                                                      const std::optional<v1::Job>& stored);
 
@@ -50,12 +53,14 @@ class WatchHub : public JobEventSink {
   class Stream;
   void Pump();
 
+  const int max_streams_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   bool work_ = false;
   bool stopping_ = false;
   std::map<std::string, v1::Job> latest_;
   std::list<Stream*> streams_;
+  int open_streams_ = 0;  // in streams_ and not yet done
   std::thread pump_;
 };
 

@@ -5,7 +5,9 @@
 #include <sys/statvfs.h>
 
 #include <chrono>
+#include <filesystem>
 #include <functional>
+#include <iostream>
 #include <memory>
 #include <thread>
 
@@ -333,6 +335,24 @@ TEST_F(Limits, ConcurrentStreamsPerConnection) {
   EXPECT_EQ(get_job(60), answered);
 }
 
+// Retries a small upload for up to 30 s while it is refused for want of a
+// slot: the daemon frees a slot when gRPC next calls the ended upload back,
+// a moment after its client has heard the end.
+grpc::Status UploadOnceASlotIsFree(rpc::MapBuilderClient& client) {
+  grpc::Status next;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  do {
+    next = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)});
+    if (next.error_code() != Code::RESOURCE_EXHAUSTED) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  } while (std::chrono::steady_clock::now() < give_up);
+  return next;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // An upload that sends its metadata and then nothing, on a connection that
 // stays alive, is cancelled after --upload-idle-timeout, and its slot is
 // free again. (The client's own deadline, far later, ends it otherwise.)
@@ -348,16 +368,162 @@ TEST_F(Limits, SilentUploadIsCancelled) {
   ASSERT_TRUE(writer->Write(message));
   const grpc::Status status = writer->Finish();  // the client sends nothing more
   EXPECT_EQ(status.error_code(), Code::CANCELLED) << status.error_message();
-  // The client hears of the cancel as soon as it is sent; the daemon frees
-  // the slot when gRPC next calls the upload back, a moment later.
-  grpc::Status next;
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  do {
-    next = RawUpload(client, Meta(v1::SCAN_FORMAT_XYZ, XyzScan(2).size()), {XyzScan(2)});
-    if (next.error_code() != Code::RESOURCE_EXHAUSTED) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  } while (std::chrono::steady_clock::now() < give_up);
+  const grpc::Status next = UploadOnceASlotIsFree(client);
   EXPECT_TRUE(next.ok()) << "the slot is free again: " << next.error_message();
+}
+
+// An upload that sends one byte and stalls is under --min-upload-kib-per-s
+// once --upload-rate-grace has passed: it ends long before the idle timeout
+// (60 s, which alone let it hold its slot that long), and the slot is free.
+TEST_F(Limits, StalledUploadIsCutAfterTheRateGrace) {
+  StartDaemon({"--workers", "1", "--max-concurrent-uploads", "1", "--upload-rate-grace", "1",
+               "--min-upload-kib-per-s", "64"});
+  auto client = Client();
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  v1::UploadScanResponse response;
+  const auto start = std::chrono::steady_clock::now();
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, 100000);
+  ASSERT_TRUE(writer->Write(message));
+  message.set_chunk("0");
+  ASSERT_TRUE(writer->Write(message));
+  const grpc::Status status = writer->Finish();  // the client sends nothing more
+  const double took = SecondsSince(start);
+  EXPECT_THAT(status.error_code(), ::testing::AnyOf(Code::CANCELLED, Code::DEADLINE_EXCEEDED))
+      << status.error_message();
+  EXPECT_LT(took, 30.0) << "cut by the rate, not by the 60 s idle timeout";
+  EXPECT_THAT(daemon_->Log(), HasSubstr("(--min-upload-kib-per-s, --upload-rate-grace)"));
+  const grpc::Status next = UploadOnceASlotIsFree(client);
+  EXPECT_TRUE(next.ok()) << "the slot is free again: " << next.error_message();
+  // Its temp file goes when gRPC releases the call.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!std::filesystem::is_empty(data_dir_ / "tmp") &&
+         std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(data_dir_ / "tmp")) << "the cut upload's temp file stayed";
+  std::cout << "stalled upload ended after " << took << " s\n";
+}
+
+// One byte every 200 ms never trips the idle timeout, but is far under the
+// minimum rate: the upload ends, naming the flag when the status reaches the
+// client (the reactor's own check), or cancelled by the watchdog. (gRPC lets
+// the client's writes succeed for a few seconds after the status is sent;
+// the slot is free from the status on.)
+TEST_F(Limits, TricklingUploadIsCutAfterTheRateGrace) {
+  StartDaemon({"--workers", "1", "--max-concurrent-uploads", "1", "--upload-rate-grace", "1",
+               "--min-upload-kib-per-s", "64", "--upload-idle-timeout", "8"});
+  auto client = Client();
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  v1::UploadScanResponse response;
+  const auto start = std::chrono::steady_clock::now();
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, 100000);
+  ASSERT_TRUE(writer->Write(message));
+  message.set_chunk("0");
+  while (SecondsSince(start) < 30.0 && writer->Write(message)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  writer->WritesDone();
+  const grpc::Status status = writer->Finish();
+  const double took = SecondsSince(start);
+  EXPECT_LT(took, 30.0) << "the trickle kept the upload open";
+  if (status.error_code() == Code::DEADLINE_EXCEEDED) {
+    EXPECT_THAT(status.error_message(), HasSubstr("(--min-upload-kib-per-s"));
+  } else {
+    EXPECT_EQ(status.error_code(), Code::CANCELLED) << status.error_message();
+  }
+  EXPECT_THAT(daemon_->Log(), HasSubstr("(--min-upload-kib-per-s, --upload-rate-grace)"));
+  EXPECT_TRUE(UploadOnceASlotIsFree(client).ok());
+  std::cout << "trickling upload ended after " << took << " s with status " << status.error_code()
+            << ": " << status.error_message() << "\n";
+}
+
+// An upload naming a stored hash is answered after its metadata: it holds
+// no slot while its client keeps the stream open, sends the bytes anyway or
+// sends nothing more.
+TEST_F(Limits, UploadNamingAStoredHashIsAnsweredAfterItsMetadata) {
+  StartDaemon({"--workers", "1", "--max-concurrent-uploads", "1"});
+  auto client = Client();
+  const std::string stored = XyzScan(100);
+  const std::string id = client.Upload(stored, Meta(v1::SCAN_FORMAT_XYZ, stored.size())).scan_id();
+  v1::ScanMetadata reuse = Meta(v1::SCAN_FORMAT_XYZ, stored.size());
+  reuse.set_sha256(id);
+
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+  v1::UploadScanResponse response;
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = reuse;
+  ASSERT_TRUE(writer->Write(message));
+  const grpc::Status status = writer->Finish();  // neither bytes nor WritesDone
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.scan_id(), id);
+  EXPECT_TRUE(response.already_present());
+  EXPECT_EQ(response.num_points(), 100u);
+
+  // A client that sends the bytes regardless (it raced another uploader) is
+  // answered too, and the store's copy is unchanged.
+  EXPECT_TRUE(RawUpload(client, reuse, {stored.substr(0, 300), stored.substr(300)}).ok());
+  EXPECT_TRUE(client.Upload(stored, Meta(v1::SCAN_FORMAT_XYZ, stored.size())).already_present());
+  EXPECT_TRUE(UploadOnceASlotIsFree(client).ok());
+}
+
+// WatchJob streams are bounded across all clients: over --max-watch-streams
+// a new one is RESOURCE_EXHAUSTED naming the flag, and once a stream ends
+// a new one is accepted.
+TEST_F(Limits, WatchStreamsOverTheCapAreRefused) {
+  StartDaemon({"--workers", "1", "--max-watch-streams", "2"});
+  auto client = Client();
+  const std::string job_id = client.Submit(SlowBatch(UploadDrive(client, 2, 37))).job_id();
+  struct Watch {
+    grpc::ClientContext context;
+    std::unique_ptr<grpc::ClientReader<v1::JobEvent>> reader;
+    v1::JobEvent first;
+    bool started = false;
+  };
+  const auto open = [&](Watch& watch) {
+    v1::WatchJobRequest request;
+    request.set_job_id(job_id);
+    watch.context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+    watch.reader = client.stub().WatchJob(&watch.context, request);
+    watch.started = watch.reader->Read(&watch.first);
+  };
+  Watch first, second, third;
+  open(first);
+  open(second);
+  ASSERT_TRUE(first.started && second.started);
+  open(third);
+  EXPECT_FALSE(third.started);
+  const grpc::Status refused = third.reader->Finish();
+  EXPECT_EQ(refused.error_code(), Code::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("(--max-watch-streams 2)"));
+
+  first.context.TryCancel();
+  first.reader->Finish();
+  // The daemon counts the stream out when gRPC releases it, a moment later.
+  bool accepted = false;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!accepted && std::chrono::steady_clock::now() < give_up) {
+    auto again = std::make_unique<Watch>();
+    open(*again);
+    accepted = again->started;
+    if (accepted) {
+      again->context.TryCancel();
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    again->reader->Finish();
+  }
+  EXPECT_TRUE(accepted) << "a stream ended, yet a new one is still refused";
+  client.Cancel(job_id);
+  second.context.TryCancel();
+  second.reader->Finish();
 }
 
 }  // namespace
