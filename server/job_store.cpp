@@ -445,13 +445,73 @@ void JobStore::PutTrajectory(const std::string& job_id,
   transaction.Commit();
 }
 
-std::vector<v1::TrajectoryPose> JobStore::GetTrajectory(const std::string& job_id) {
+namespace {
+
+// Where a results page resumes: after the pair (plan_order, source, target),
+// at the pose `pose`. The token is the four numbers, colon-separated.
+struct ResultsCursor {
+  int64_t plan_order = -1, source = -1, target = -1, pose = 0;
+};
+
+ResultsCursor ParseResultsToken(const std::string& token) {
+  ResultsCursor cursor;
+  if (token.empty()) return cursor;
+  long long v[4];
+  int used = 0;
+  if (std::sscanf(token.c_str(), "%lld:%lld:%lld:%lld%n", &v[0], &v[1], &v[2], &v[3], &used) != 4 ||
+      static_cast<size_t>(used) != token.size() || v[3] < 0) {
+    throw InputError("page_token: not a token from a previous GetResults response");
+  }
+  return {v[0], v[1], v[2], v[3]};
+}
+
+}  // namespace
+
+ResultsPage JobStore::GetResultsPage(const std::string& job_id, int page_size,
+                                     const std::string& page_token) {
+  ResultsCursor cursor = ParseResultsToken(page_token);
   std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare("SELECT pose FROM trajectories WHERE job_id = ?1 ORDER BY idx");
-  stmt.Bind(1, job_id);
-  std::vector<v1::TrajectoryPose> poses;
-  while (stmt.Step()) poses.push_back(Parse<v1::TrajectoryPose>(stmt.ColumnBlob(0), "pose"));
-  return poses;
+  ResultsPage page;
+  bool more = false;
+  // One row past the page says whether another page follows.
+  auto pairs = db_.Prepare(
+      "SELECT plan_order, source, target, result, answered_by FROM pair_results "
+      "WHERE job_id = ?1 AND (plan_order, source, target) > (?2, ?3, ?4) "
+      "ORDER BY plan_order, source, target LIMIT ?5");
+  pairs.Bind(1, job_id)
+      .Bind(2, cursor.plan_order)
+      .Bind(3, cursor.source)
+      .Bind(4, cursor.target)
+      .Bind(5, static_cast<int64_t>(page_size) + 1);
+  while (pairs.Step()) {
+    if (static_cast<int>(page.pairs.size()) == page_size) {
+      more = true;
+      break;
+    }
+    v1::PairResult result = Parse<v1::PairResult>(pairs.ColumnBlob(3), "pair");
+    result.set_answered_by(pairs.ColumnText(4));  // as in GetPairs
+    page.pairs.push_back(std::move(result));
+    cursor.plan_order = pairs.ColumnInt(0);
+    cursor.source = pairs.ColumnInt(1);
+    cursor.target = pairs.ColumnInt(2);
+  }
+  auto poses = db_.Prepare(
+      "SELECT idx, pose FROM trajectories WHERE job_id = ?1 AND idx >= ?2 ORDER BY idx LIMIT ?3");
+  poses.Bind(1, job_id).Bind(2, cursor.pose).Bind(3, static_cast<int64_t>(page_size) + 1);
+  int64_t next_pose = cursor.pose;
+  while (poses.Step()) {
+    if (static_cast<int>(page.poses.size()) == page_size) {
+      more = true;
+      break;
+    }
+    page.poses.push_back(Parse<v1::TrajectoryPose>(poses.ColumnBlob(1), "pose"));
+    next_pose = poses.ColumnInt(0) + 1;
+  }
+  if (more) {
+    page.next_page_token = std::to_string(cursor.plan_order) + ":" + std::to_string(cursor.source) +
+                           ":" + std::to_string(cursor.target) + ":" + std::to_string(next_pose);
+  }
+  return page;
 }
 
 void JobStore::Checkpoint() {

@@ -39,6 +39,12 @@ struct StoredPair {
   InformationMatrix information = InformationMatrix::Identity();
 };
 
+struct ResultsPage {
+  std::vector<v1::PairResult> pairs;
+  std::vector<v1::TrajectoryPose> poses;
+  std::string next_page_token;  // empty on the last page
+};
+
 struct JobPage {
   std::vector<v1::Job> jobs;
   std::string next_page_token;
@@ -106,7 +112,11 @@ class JobStore {
   void MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph);
 
   void PutTrajectory(const std::string& job_id, const std::vector<v1::TrajectoryPose>& poses);
-  std::vector<v1::TrajectoryPose> GetTrajectory(const std::string& job_id);
+  /// Up to `page_size` (>= 1) pairs, in plan order, and up to as many poses,
+  /// after where `page_token` (empty = the start) says the previous page
+  /// ended. Throws InputError on a token no page gave.
+  ResultsPage GetResultsPage(const std::string& job_id, int page_size,
+                             const std::string& page_token);
 
   /// Moves the WAL into the main file (on a clean shutdown).
   void Checkpoint();

@@ -14,6 +14,7 @@ namespace {
 constexpr int kDefaultPageSize = 50;
 constexpr int kMaxPageSize = 500;
 constexpr int kMaxFindScans = 100000;
+constexpr uint32_t kMaxResultsPage = 2000;  // pairs, and poses, per GetResults page
 
 // Runs a unary handler: authentication, then `handler`, whose exceptions
 // become the matching status.
@@ -154,12 +155,16 @@ grpc::ServerUnaryReactor* MapBuilderService::GetResults(grpc::CallbackServerCont
                                                         v1::JobResults* response) {
   return Unary(deps_, context, "GetResults", [&] {
     *response->mutable_job() = RequireJob(deps_, request->job_id());
-    for (const StoredPair& pair : deps_.store.GetPairs(request->job_id())) {
-      *response->add_pairs() = pair.result;
-    }
-    for (const v1::TrajectoryPose& pose : deps_.store.GetTrajectory(request->job_id())) {
-      *response->add_trajectory() = pose;
-    }
+    // Paged, so that neither the reply nor its copy in memory grows with the
+    // job: a page stays near 2 MB (pairs of about 0.4 KB, poses of 0.5 KB),
+    // under the default 4 MiB message limit.
+    const uint32_t asked = request->page_size();
+    const int size =
+        static_cast<int>(asked == 0 ? kMaxResultsPage : std::min<uint32_t>(asked, kMaxResultsPage));
+    ResultsPage page = deps_.store.GetResultsPage(request->job_id(), size, request->page_token());
+    for (v1::PairResult& pair : page.pairs) *response->add_pairs() = std::move(pair);
+    for (v1::TrajectoryPose& pose : page.poses) *response->add_trajectory() = std::move(pose);
+    response->set_next_page_token(page.next_page_token);
     return grpc::Status::OK;
   });
 }

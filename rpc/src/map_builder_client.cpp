@@ -156,13 +156,27 @@ v1::ListJobsResponse MapBuilderClient::ListJobs(uint32_t page_size, const std::s
   return response;
 }
 
-v1::JobResults MapBuilderClient::Results(const std::string& job_id) {
-  grpc::ClientContext context;
-  PrepareUnary(context);
+v1::JobResults MapBuilderClient::Results(const std::string& job_id, uint32_t page_size) {
+  v1::JobResults results;
   v1::GetResultsRequest request;
   request.set_job_id(job_id);
-  v1::JobResults results;
-  Check("GetResults", stub_->GetResults(&context, request, &results));
+  request.set_page_size(page_size);
+  do {
+    grpc::ClientContext context;
+    PrepareUnary(context);
+    v1::JobResults page;
+    Check("GetResults", stub_->GetResults(&context, request, &page));
+    if (!page.next_page_token().empty() && page.next_page_token() == request.page_token()) {
+      throw std::runtime_error("GetResults: the daemon returned the same page token twice");
+    }
+    // The first page's job: the pages that follow are the results as of then.
+    if (!results.has_job()) *results.mutable_job() = std::move(*page.mutable_job());
+    for (v1::PairResult& pair : *page.mutable_pairs()) *results.add_pairs() = std::move(pair);
+    for (v1::TrajectoryPose& pose : *page.mutable_trajectory()) {
+      *results.add_trajectory() = std::move(pose);
+    }
+    request.set_page_token(page.next_page_token());
+  } while (!request.page_token().empty());
   return results;
 }
 

@@ -526,5 +526,51 @@ TEST_F(Limits, WatchStreamsOverTheCapAreRefused) {
   second.reader->Finish();
 }
 
+// GetResults is paged, so neither the reply nor its copy in the daemon grows
+// with the job; the client gathers the pages into the same results.
+TEST_F(Limits, GetResultsIsPagedAndTheClientGathersEveryPage) {
+  StartDaemon({"--workers", "1"});
+  auto client = Client();
+  const v1::Job done = client.Watch(client.Submit(QuickBatch(UploadDrive(client, 4, 41))).job_id());
+  ASSERT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();
+  const v1::JobResults whole = client.Results(done.job_id());
+  ASSERT_EQ(whole.pairs_size(), 3);
+  ASSERT_EQ(whole.trajectory_size(), 4);
+
+  const auto page = [&](uint32_t size, const std::string& token, v1::JobResults& results) {
+    grpc::ClientContext context;
+    v1::GetResultsRequest request;
+    request.set_job_id(done.job_id());
+    request.set_page_size(size);
+    request.set_page_token(token);
+    return client.stub().GetResults(&context, request, &results);
+  };
+  v1::JobResults first, last;
+  ASSERT_TRUE(page(2, "", first).ok());
+  EXPECT_EQ(first.pairs_size(), 2);
+  EXPECT_EQ(first.trajectory_size(), 2);
+  ASSERT_FALSE(first.next_page_token().empty());
+  ASSERT_TRUE(page(2, first.next_page_token(), last).ok());
+  EXPECT_EQ(last.pairs_size(), 1);
+  EXPECT_EQ(last.trajectory_size(), 2);
+  EXPECT_TRUE(last.next_page_token().empty()) << "every result was sent";
+
+  const v1::JobResults gathered = client.Results(done.job_id(), 1);
+  ASSERT_EQ(gathered.pairs_size(), whole.pairs_size());
+  ASSERT_EQ(gathered.trajectory_size(), whole.trajectory_size());
+  for (int i = 0; i < whole.pairs_size(); ++i) {
+    EXPECT_EQ(gathered.pairs(i).SerializeAsString(), whole.pairs(i).SerializeAsString()) << i;
+  }
+  for (int i = 0; i < whole.trajectory_size(); ++i) {
+    EXPECT_EQ(gathered.trajectory(i).SerializeAsString(), whole.trajectory(i).SerializeAsString())
+        << i;
+  }
+
+  v1::JobResults refused;
+  const grpc::Status status = page(2, "12:x", refused);
+  EXPECT_EQ(status.error_code(), Code::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("page_token"));
+}
+
 }  // namespace
 }  // namespace boicp::test

@@ -69,7 +69,9 @@ class MapBuilderClient {
   v1::DeleteJobResponse Delete(const std::string& job_id);
   /// One page of jobs, newest first; page_size 0 = the daemon's default (50).
   v1::ListJobsResponse ListJobs(uint32_t page_size = 0, const std::string& page_token = "");
-  v1::JobResults Results(const std::string& job_id);
+  /// Every result of the job, gathered page by page; `page_size` pairs (and
+  /// poses) per GetResults call, 0 = the daemon's maximum (2000).
+  v1::JobResults Results(const std::string& job_id, uint32_t page_size = 0);
 
   /// Follows WatchJob to its end and returns the job of the last event.
   /// Throws RpcError when the stream ends with an error status.
