@@ -349,6 +349,19 @@ grpc::Status UploadOnceASlotIsFree(rpc::MapBuilderClient& client) {
   return next;
 }
 
+// Opens an upload with a deadline far beyond the daemon's limits and sends
+// `metadata`; null when the metadata could not be sent.
+std::unique_ptr<grpc::ClientWriter<v1::UploadScanRequest>> OpenUpload(
+    rpc::MapBuilderClient& client, grpc::ClientContext& context, v1::UploadScanResponse& response,
+    const v1::ScanMetadata& metadata) {
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  auto writer = client.stub().UploadScan(&context, &response);
+  v1::UploadScanRequest message;
+  *message.mutable_metadata() = metadata;
+  if (!writer->Write(message)) return nullptr;
+  return writer;
+}
+
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -360,12 +373,9 @@ TEST_F(Limits, SilentUploadIsCancelled) {
   StartDaemon({"--workers", "1", "--max-concurrent-uploads", "1", "--upload-idle-timeout", "1"});
   auto client = Client();
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
   v1::UploadScanResponse response;
-  auto writer = client.stub().UploadScan(&context, &response);
-  v1::UploadScanRequest message;
-  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, 100);
-  ASSERT_TRUE(writer->Write(message));
+  auto writer = OpenUpload(client, context, response, Meta(v1::SCAN_FORMAT_XYZ, 100));
+  ASSERT_TRUE(writer);
   const grpc::Status status = writer->Finish();  // the client sends nothing more
   EXPECT_EQ(status.error_code(), Code::CANCELLED) << status.error_message();
   const grpc::Status next = UploadOnceASlotIsFree(client);
@@ -380,13 +390,11 @@ TEST_F(Limits, StalledUploadIsCutAfterTheRateGrace) {
                "--min-upload-kib-per-s", "64"});
   auto client = Client();
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
   v1::UploadScanResponse response;
   const auto start = std::chrono::steady_clock::now();
-  auto writer = client.stub().UploadScan(&context, &response);
+  auto writer = OpenUpload(client, context, response, Meta(v1::SCAN_FORMAT_XYZ, 100000));
+  ASSERT_TRUE(writer);
   v1::UploadScanRequest message;
-  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, 100000);
-  ASSERT_TRUE(writer->Write(message));
   message.set_chunk("0");
   ASSERT_TRUE(writer->Write(message));
   const grpc::Status status = writer->Finish();  // the client sends nothing more
@@ -417,13 +425,11 @@ TEST_F(Limits, TricklingUploadIsCutAfterTheRateGrace) {
                "--min-upload-kib-per-s", "64", "--upload-idle-timeout", "8"});
   auto client = Client();
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
   v1::UploadScanResponse response;
   const auto start = std::chrono::steady_clock::now();
-  auto writer = client.stub().UploadScan(&context, &response);
+  auto writer = OpenUpload(client, context, response, Meta(v1::SCAN_FORMAT_XYZ, 100000));
+  ASSERT_TRUE(writer);
   v1::UploadScanRequest message;
-  *message.mutable_metadata() = Meta(v1::SCAN_FORMAT_XYZ, 100000);
-  ASSERT_TRUE(writer->Write(message));
   message.set_chunk("0");
   while (SecondsSince(start) < 30.0 && writer->Write(message)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));

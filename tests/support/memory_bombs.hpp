@@ -33,6 +33,17 @@ inline void AppendBigEndianU32(std::string* out, uint32_t v) {
   for (int i = 3; i >= 0; --i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xff));
 }
 
+/// An LZF back-reference copying the byte before `length` (3..264) times.
+inline void AppendLzfRepeatOfPreviousByte(std::string* lzf, uint64_t length) {
+  if (length - 2 < 7) {
+    lzf->push_back(static_cast<char>((length - 2) << 5));
+  } else {
+    lzf->push_back(static_cast<char>(0xE0));
+    lzf->push_back(static_cast<char>(length - 2 - 7));
+  }
+  lzf->push_back('\0');  // offset 0: the byte before
+}
+
 /// LZF data that decodes to `size` zero bytes: a one-byte literal, then
 /// back-references to the byte before (3 bytes each for 264 bytes, LZF's
 /// best), and a literal for what remains. About 88 times smaller than decoded.
@@ -42,13 +53,7 @@ inline std::string LzfZeros(uint64_t size) {
   while (left >= 3) {
     uint64_t length = std::min<uint64_t>(264, left);
     if (left - length > 0 && left - length < 3) length = left - 3;
-    if (length - 2 < 7) {
-      lzf.push_back(static_cast<char>((length - 2) << 5));
-    } else {
-      lzf.push_back(static_cast<char>(0xE0));
-      lzf.push_back(static_cast<char>(length - 2 - 7));
-    }
-    lzf.push_back('\0');  // offset 0: the byte before
+    AppendLzfRepeatOfPreviousByte(&lzf, length);
     left -= length;
   }
   if (left > 0) {
@@ -70,13 +75,7 @@ inline std::string LzfZerosEightfold(uint64_t size) {
     left -= literal;
     if (left < 3) continue;
     const uint64_t length = std::min<uint64_t>(264, left);
-    if (length - 2 < 7) {
-      lzf.push_back(static_cast<char>((length - 2) << 5));
-    } else {
-      lzf.push_back(static_cast<char>(0xE0));
-      lzf.push_back(static_cast<char>(length - 2 - 7));
-    }
-    lzf.push_back('\0');  // offset 0: the byte before
+    AppendLzfRepeatOfPreviousByte(&lzf, length);
     left -= length;
   }
   return lzf;
