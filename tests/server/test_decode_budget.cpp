@@ -14,6 +14,7 @@
 #include "../support/demo_sequence.hpp"
 #include "../support/files_and_processes.hpp"
 #include "../support/memory_bombs.hpp"
+#include "../support/sanitized_build.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "server_fixture.hpp"
 
@@ -69,7 +70,11 @@ TEST_F(DecodeBudgetUploads, NearBudgetUploadsAtOnceAllSucceedAndThePeakStaysNear
     EXPECT_TRUE(statuses[i].ok()) << i << ": " << statuses[i].error_message();
     EXPECT_EQ(points[i], kNearBudgetPoints + static_cast<uint64_t>(i));
   }
-  EXPECT_LT(peak_mb, start_mb + kBudgetMb + kSlackMb);
+  // The peak means nothing under a sanitizer's allocator; the uploads must
+  // still all succeed there.
+  if (!kSanitizedBuild) {
+    EXPECT_LT(peak_mb, start_mb + kBudgetMb + kSlackMb);
+  }
   ASSERT_EQ(daemon_->Wait(0.1), -1) << "the daemon exited";
 }
 

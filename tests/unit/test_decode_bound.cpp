@@ -22,6 +22,7 @@
 #include <open3d/io/ImageIO.h>
 #include <open3d/io/PointCloudIO.h>
 
+#include "../support/sanitized_build.hpp"
 #include "boicp/io/decode_budget.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 
@@ -43,20 +44,6 @@ uint64_t StatusBytes(const std::string& field) {
   }
   return 0;
 }
-
-// A sanitizer's allocator (shadow memory, redzones, quarantine) takes more
-// than the loads ask for: the memory measurement means nothing under one.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
 
 constexpr uint64_t kCannotMeasure = ~uint64_t{0};
 constexpr uint64_t kLoadFailed = kCannotMeasure - 1;
@@ -208,7 +195,7 @@ TEST_F(DecodeBoundTest, HeaderErrorsAreTheLoadersOwn) {
 // bound by more than the allocator's and the readers' small buffers, and
 // must be most of it (else the measurement saw nothing).
 TEST_F(DecodeBoundTest, ALoadNeverTakesMuchMoreThanItsBound) {
-  if (kSanitized) GTEST_SKIP() << "a sanitizer's allocator inflates resident memory";
+  if (kSanitizedBuild) GTEST_SKIP() << "a sanitizer's allocator inflates resident memory";
   constexpr uint64_t kSmallBuffers = 8u << 20;
   std::string xyz;
   for (int i = 0; i < 1000000; ++i) xyz += "1 2 3\n";
