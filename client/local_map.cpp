@@ -53,7 +53,7 @@ std::vector<PairIndex> ListedPairs(const PairingPlan& plan, const RegisteredPair
 
 // preview.png and pairs.json of an assembled map.
 MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap& map,
-                                        const std::vector<PairRecord>& listed,
+                                        std::vector<PairResult> listed,
                                         const std::string& out_dir) {
   const fs::path dir(out_dir);
   UpDetectionOptions up_options;
@@ -65,10 +65,9 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
 
   const std::set<PairIndex> in_graph(map.in_graph.begin(), map.in_graph.end());
   json listing = json::array();
-  for (const PairRecord& r : listed) {
-    json entry = PairRecordToJson(r);
-    entry["in_graph"] = in_graph.count(r.pair) > 0;
-    listing.push_back(std::move(entry));
+  for (PairResult& r : listed) {
+    r.in_graph = in_graph.count(r.pair) > 0;
+    listing.push_back(PairListingJson(run.folder.scans, r));
   }
   WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
 
@@ -79,9 +78,9 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   summary.points_out_of_range = map.fusion.points_out_of_range;
   summary.fusion_s = map.fusion.seconds;
   summary.pairs = static_cast<int>(listed.size());
-  summary.pairs_doubtful = static_cast<int>(std::count_if(
-      listed.begin(), listed.end(), [](const PairRecord& r) { return IsDoubtful(r); }));
-  for (const PairRecord& r : listed) summary.answered_by.push_back(r.answered_by);
+  summary.pairs_doubtful = static_cast<int>(
+      std::count_if(listed.begin(), listed.end(), [](const PairResult& r) { return r.doubtful; }));
+  for (const PairResult& r : listed) summary.answered_by.push_back(r.answered_by);
   return summary;
 }
 
@@ -115,9 +114,9 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
 }
 
 MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads) {
-  const MapBatch batch = RunBatch(run, RunPlan(run));
+  const MapBatch batch = RunBatch(run, run.plan);
   PairFileStore store(batch.scans, batch.config, out_dir);
-  TerminalProgress progress(store);
+  TerminalProgress progress;
   fs::create_directories(out_dir);
   MapPipelineResult result;
   {
@@ -125,9 +124,9 @@ MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, 
     result =
         RunMapPipeline(batch, store, progress, LocalExecution(pool), LocalOutputPaths(out_dir));
   }
-  std::vector<PairRecord> listed;
+  std::vector<PairResult> listed;
   for (const PairIndex& pair : ListedPairs(batch.plan, result.pairs)) {
-    listed.push_back(store.Record(pair));
+    listed.push_back(result.pairs.finished.at(pair));
   }
   MapOutputSummary summary = WriteListingAndPreview(run, result.map, listed, out_dir);
   summary.pairs_reused = progress.reused();
@@ -138,7 +137,7 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
                        const std::string& out_dir, int threads) {
   const MapBatch batch = RunBatch(run, PlanFixedPairs(pairs));
   PairFileStore store(batch.scans, batch.config, out_dir);
-  TerminalProgress progress(store);
+  TerminalProgress progress;
   ThreadPool pool(threads);
   RegisterPlannedPairs(batch.scans, batch.config, batch.plan, store, progress,
                        LocalExecution(pool));
@@ -147,20 +146,20 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
 }
 
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,
-                                     const std::map<PairIndex, PairRecord>& records,
+                                     const std::map<PairIndex, PairResult>& results,
                                      const std::string& out_dir) {
-  const MapBatch batch = RunBatch(run, RunPlan(run));
+  const MapBatch batch = RunBatch(run, run.plan);
   RegisteredPairs registered;
-  for (const auto& [pair, record] : records) registered.finished[pair] = FinishedFromRecord(record);
+  registered.finished = results;
   registered.chain = batch.plan.chain;
   PairFileStore store(batch.scans, batch.config, out_dir);
-  TerminalProgress progress(store);
+  TerminalProgress progress;
   fs::create_directories(out_dir);
   const AssembledMap map =
       AssembleMap(batch, registered, store, progress, LocalOutputPaths(out_dir));
-  std::vector<PairRecord> listed;
+  std::vector<PairResult> listed;
   for (const PairIndex& pair : ListedPairs(batch.plan, registered))
-    listed.push_back(records.at(pair));
+    listed.push_back(results.at(pair));
   return WriteListingAndPreview(run, map, listed, out_dir);
 }
 

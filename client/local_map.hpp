@@ -38,10 +38,10 @@ MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, 
 int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
                        const std::string& out_dir, int threads);
 
-/// `boicp merge`: the map from records already read (ReadStoredPairs, one
+/// `boicp merge`: the map from results already read (ReadStoredPairs, one
 /// per pair of run.plan), written to OUTDIR as BuildLocalMap does.
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,
-                                     const std::map<PairIndex, PairRecord>& records,
+                                     const std::map<PairIndex, PairResult>& results,
                                      const std::string& out_dir);
 
 }  // namespace boicp::cli

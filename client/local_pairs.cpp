@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "boicp/settings/rung_summary.hpp"
+#include "boicp/settings/pair_result_json.hpp"
 #include "boicp/settings/settings_json.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "json_output.hpp"
@@ -26,15 +26,6 @@ json ScanSettings(const ScanSource& scan) {
   }
   out["prior_pose"] = scan.prior_pose ? TransformToJson(*scan.prior_pose) : json(nullptr);
   return out;
-}
-
-Transform TransformFromJson(const json& rows) {
-  Transform T;
-  for (int i = 0; i < 4; ++i) {
-    for (int j = 0; j < 4; ++j)
-      T(i, j) = rows.at(static_cast<size_t>(i)).at(static_cast<size_t>(j)).get<double>();
-  }
-  return T;
 }
 
 // The config object of a pair's settings: the registration settings as used,
@@ -72,26 +63,11 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
   config = PairConfigJson(settings::ConfigFromJson(config, source));
 }
 
-// A pair file's answered_by: one of RungName's words.
-Rung RungOfFile(const json& value) {
-  const std::string name = value.get<std::string>();
-  const std::optional<Rung> rung = settings::RungFromName(name);
-  if (!rung) throw InputError("answered_by: unknown rung '" + name + "'");
-  return *rung;
-}
-
-// null for unknown.
-template <typename T>
-std::optional<T> OptionalOf(const json& value) {
-  if (value.is_null()) return std::nullopt;
-  return value.get<T>();
-}
-
 // Pair files without a "format" (written before there was one) lack the
-// keys added since: they read as unknown (doubtful, overlap, search_reach),
-// the full search (answered_by, as every pair was before the ladder) and the
-// settings under today's names. Files of a later format are refused, not
-// misread.
+// keys added since: they read as trusted (no doubtful flag, PairResult's
+// confidence), unknown (overlap, search_reach), the full search
+// (answered_by, as every pair was before the ladder) and the settings under
+// today's names. Files of a later format are refused, not misread.
 void MigratePairFile(json& j, const std::string& path) {
   const int format = j.value("format", 0);
   if (format > kPairFileFormat) {
@@ -100,7 +76,11 @@ void MigratePairFile(json& j, const std::string& path) {
                              "); use the boicp that wrote it");
   }
   if (format == kPairFileFormat) return;
-  for (const char* key : {"doubtful", "overlap", "search_reach"}) {
+  if (!j.contains("doubtful")) {
+    j["doubtful"] = false;
+    j["confidence"] = 1.0;
+  }
+  for (const char* key : {"overlap", "search_reach"}) {
     if (!j.contains(key)) j[key] = nullptr;
   }
   if (!j.contains("answered_by")) j["answered_by"] = RungName(Rung::kFullSearch);
@@ -117,113 +97,40 @@ json PairSettings(const std::vector<ScanSource>& scans, const PairIndex& pair,
           {"target", ScanSettings(scans.at(static_cast<size_t>(pair.target)))}};
 }
 
-PairRecord MakePairRecord(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                          const BatchPairResult& result, json settings) {
-  const RegistrationResult& r = result.registration;
-  PairRecord record;
-  record.pair = pair;
-  record.source_path = scans.at(static_cast<size_t>(pair.source)).path;
-  record.target_path = scans.at(static_cast<size_t>(pair.target)).path;
-  record.transform = r.transform;
-  record.objective = r.objective;
-  record.fitness = r.fitness;
-  record.inlier_rmse = r.inlier_rmse;
-  record.confidence = r.confidence;
-  record.overlap = r.overlap;
-  record.search_reach = r.search_reach;
-  record.doubtful = r.doubtful;
-  record.answered_by = r.answered_by;
-  record.evaluations = r.evaluations;
-  record.runtime_s = r.runtime_s;
-  record.seed = result.seed;
-  record.information = r.information;
-  record.settings = std::move(settings);
-  return record;
-}
-
 std::string PairFilePath(const std::string& out_dir, const PairIndex& pair) {
   char name[64];
   std::snprintf(name, sizeof(name), "%06d-%06d.json", pair.source, pair.target);
   return (std::filesystem::path(out_dir) / "pairs" / name).string();
 }
 
-json PairRecordToJson(const PairRecord& r) {
-  return {{"source", r.pair.source},
-          {"target", r.pair.target},
-          {"source_path", r.source_path},
-          {"target_path", r.target_path},
-          {"transform", TransformToJson(r.transform)},
-          {"objective", r.objective},
-          {"fitness", r.fitness},
-          {"inlier_rmse", r.inlier_rmse},
-          {"confidence", r.confidence},
-          {"doubtful", IsDoubtful(r)},
-          {"overlap", r.overlap ? json(*r.overlap) : json(nullptr)},
-          {"search_reach", r.search_reach ? json(*r.search_reach) : json(nullptr)},
-          {"answered_by", RungName(r.answered_by)},
-          {"evaluations", r.evaluations},
-          {"runtime_s", r.runtime_s},
-          {"seed", r.seed}};
+json PairListingJson(const std::vector<ScanSource>& scans, const PairResult& result) {
+  json out = settings::PairResultToJson(result, kPairListing);
+  out["source_path"] = scans.at(static_cast<size_t>(result.pair.source)).path;
+  out["target_path"] = scans.at(static_cast<size_t>(result.pair.target)).path;
+  return out;
 }
 
-bool IsDoubtful(const PairRecord& record) { return record.doubtful.value_or(false); }
-
-double PlannerOverlap(const PairRecord& record) { return record.overlap.value_or(record.fitness); }
-
-PairConstraint RecordConstraint(const PairRecord& record) {
-  return {record.pair, record.transform, record.information,
-          record.doubtful ? record.confidence : 1.0};
-}
-
-void WritePairFile(const std::string& out_dir, const PairRecord& record) {
+void WritePairFile(const std::string& out_dir, const std::vector<ScanSource>& scans,
+                   const PairResult& result, const json& settings) {
   std::filesystem::create_directories(std::filesystem::path(out_dir) / "pairs");
-  json out = PairRecordToJson(record);
-  json information = json::array();
-  for (int i = 0; i < 6; ++i) {
-    json row = json::array();
-    for (int j = 0; j < 6; ++j) row.push_back(record.information(i, j));
-    information.push_back(row);
-  }
-  out["information"] = information;
-  out["settings"] = record.settings;
+  json out = settings::PairResultToJson(result, kPairFile);
+  out["source_path"] = scans.at(static_cast<size_t>(result.pair.source)).path;
+  out["target_path"] = scans.at(static_cast<size_t>(result.pair.target)).path;
+  out["settings"] = settings;
   out["format"] = kPairFileFormat;
-  WriteTextFileAtomically(PairFilePath(out_dir, record.pair), out.dump(1) + "\n");
+  WriteTextFileAtomically(PairFilePath(out_dir, result.pair), out.dump(1) + "\n");
 }
 
-std::optional<PairRecord> ReadPairFile(const std::string& out_dir, const PairIndex& pair) {
+std::optional<PairFile> ReadPairFile(const std::string& out_dir, const PairIndex& pair) {
   const std::string path = PairFilePath(out_dir, pair);
   std::ifstream in(path);
   if (!in) return std::nullopt;
   try {
     json j = json::parse(in);
     MigratePairFile(j, path);
-    PairRecord r;
-    r.pair = {j.at("source").get<int>(), j.at("target").get<int>()};
-    if (!(r.pair == pair))
-      throw InputError("holds pair " + std::to_string(r.pair.source) + "->" +
-                       std::to_string(r.pair.target));
-    r.source_path = j.at("source_path").get<std::string>();
-    r.target_path = j.at("target_path").get<std::string>();
-    r.transform = TransformFromJson(j.at("transform"));
-    r.objective = j.at("objective").get<double>();
-    r.fitness = j.at("fitness").get<double>();
-    r.inlier_rmse = j.at("inlier_rmse").get<double>();
-    r.confidence = j.at("confidence").get<double>();
-    r.doubtful = OptionalOf<bool>(j.at("doubtful"));
-    r.overlap = OptionalOf<double>(j.at("overlap"));
-    r.search_reach = OptionalOf<double>(j.at("search_reach"));
-    r.answered_by = RungOfFile(j.at("answered_by"));
-    r.evaluations = j.at("evaluations").get<int>();
-    r.runtime_s = j.at("runtime_s").get<double>();
-    r.seed = j.at("seed").get<uint64_t>();
-    for (int i = 0; i < 6; ++i) {
-      for (int k = 0; k < 6; ++k) {
-        r.information(i, k) =
-            j.at("information").at(static_cast<size_t>(i)).at(static_cast<size_t>(k)).get<double>();
-      }
-    }
-    r.settings = j.at("settings");
-    return r;
+    PairFile file{settings::PairResultFromJson(j, kPairFile), j.at("settings")};
+    if (!(file.result.pair == pair)) throw InputError("holds pair " + PairName(file.result.pair));
+    return file;
   } catch (const NewerPairFileError&) {
     throw;
   } catch (const std::exception& e) {

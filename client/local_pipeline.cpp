@@ -50,6 +50,8 @@ json MapSettingsToJson(const MapSettings& s) {
               {"layout", s.layout},
               {"pairing", s.pairing},
               {"pairs_file", s.pairs_file},
+              {"overlap_threshold", s.overlap_threshold},
+              {"extra_pairs_file", s.extra_pairs_file},
               {"first", s.first},
               {"stride", s.stride},
               {"count", s.count},
@@ -68,6 +70,9 @@ MapSettings MapSettingsFromJson(const json& j, const std::string& source) {
     s.layout = j.at("layout").get<std::string>();
     s.pairing = j.at("pairing").get<std::string>();
     s.pairs_file = j.at("pairs_file").get<std::string>();
+    // Runs written before these settings existed had neither.
+    s.overlap_threshold = j.value("overlap_threshold", 0.0);
+    s.extra_pairs_file = j.value("extra_pairs_file", std::string());
     s.first = j.at("first").get<int>();
     s.stride = j.at("stride").get<int>();
     s.count = j.at("count").get<int>();
@@ -102,6 +107,35 @@ std::vector<PairIndex> ReadPairsFile(const std::string& path) {
   return pairs;
 }
 
+namespace {
+
+// The pairing the settings ask for, with the pairs read from their files.
+PairingRequest PairingOfSettings(const MapSettings& settings) {
+  PairingRequest pairing;
+  const std::optional<PairingMode> mode = PairingModeFromName(settings.pairing);
+  if (!mode) {
+    throw InputError("--pairing: '" + settings.pairing +
+                     "' is not consecutive, overlap or explicit");
+  }
+  pairing.mode = *mode;
+  if (pairing.mode == PairingMode::kExplicit) {
+    if (settings.pairs_file.empty()) throw InputError("--pairing explicit needs a pairs FILE");
+    if (!settings.extra_pairs_file.empty()) {
+      throw InputError("--extra-pairs: explicit pairing lists every pair in its FILE");
+    }
+    pairing.pairs = ReadPairsFile(settings.pairs_file);
+  } else if (!settings.extra_pairs_file.empty()) {
+    pairing.pairs = ReadPairsFile(settings.extra_pairs_file);
+  }
+  if (settings.overlap_threshold != 0.0 && pairing.mode != PairingMode::kOverlap) {
+    throw InputError("--overlap-threshold: only overlap pairing has one");
+  }
+  pairing.overlap_threshold = settings.overlap_threshold;
+  return pairing;
+}
+
+}  // namespace
+
 LocalRun PrepareRun(const MapSettings& settings) {
   LocalRun run;
   run.settings = settings;
@@ -120,23 +154,10 @@ LocalRun PrepareRun(const MapSettings& settings) {
     throw InputError(settings.path + ": a map needs at least 2 scans, the selection has " +
                      std::to_string(n));
   }
-  if (settings.pairing == "consecutive") {
-    run.plan = ConsecutivePairs(n);
-  } else if (settings.pairing == "explicit") {
-    if (settings.pairs_file.empty()) throw InputError("--pairing explicit needs a pairs FILE");
-    run.plan = ReadPairsFile(settings.pairs_file);
-    try {
-      ValidatePairs(n, run.plan, /*require_connected=*/true);
-    } catch (const InputError& e) {
-      throw InputError(settings.pairs_file + ": " + e.what());
-    }
-  } else if (settings.pairing == "overlap") {
-    run.keyframes = true;
-    run.overlap_threshold = BatchOverlapThreshold(run.folder.scans, run.config.sensor);
-  } else {
-    throw InputError("--pairing: '" + settings.pairing +
-                     "' is not consecutive, overlap or explicit");
-  }
+  run.pairing = PairingOfSettings(settings);
+  run.plan =
+      PlanPairing(run.pairing, run.folder.scans, run.config.sensor,
+                  settings.pairing == "explicit" ? settings.pairs_file : settings.extra_pairs_file);
   return run;
 }
 
@@ -203,28 +224,30 @@ json RunManifestJson(const LocalRun& run) {
   return manifest;
 }
 
-PairingPlan RunPlan(const LocalRun& run) {
-  return run.keyframes ? PlanKeyframes(run.overlap_threshold) : PlanFixedPairs(run.plan);
+std::vector<PairIndex> FixedPlanPairs(const PairingPlan& plan) {
+  std::vector<PairIndex> pairs = plan.chain;
+  pairs.insert(pairs.end(), plan.extras.begin(), plan.extras.end());
+  return pairs;
 }
 
-std::map<PairIndex, PairRecord> ReadStoredPairs(const LocalRun& run,
+std::map<PairIndex, PairResult> ReadStoredPairs(const LocalRun& run,
                                                 const std::vector<PairIndex>& pairs,
                                                 const std::vector<std::string>& dirs) {
-  std::map<PairIndex, PairRecord> records;
+  std::map<PairIndex, PairResult> results;
   std::string missing;
   int missing_count = 0;
   for (const PairIndex& pair : pairs) {
     for (const std::string& dir : dirs) {
-      std::optional<PairRecord> record = ReadPairFile(dir, pair);
-      if (!record) continue;
-      if (record->settings != PairSettings(run.folder.scans, pair, run.config)) {
+      std::optional<PairFile> file = ReadPairFile(dir, pair);
+      if (!file) continue;
+      if (file->settings != PairSettings(run.folder.scans, pair, run.config)) {
         throw InputError(PairFilePath(dir, pair) + ": computed with other settings than " +
                          RunManifestPath(dir) + " (rerun that shard)");
       }
-      records[pair] = std::move(*record);
+      results[pair] = std::move(file->result);
       break;
     }
-    if (records.count(pair) == 0 && ++missing_count <= 10) {
+    if (results.count(pair) == 0 && ++missing_count <= 10) {
       missing += (missing.empty() ? "" : ", ") + PairName(pair);
     }
   }
@@ -233,7 +256,7 @@ std::map<PairIndex, PairRecord> ReadStoredPairs(const LocalRun& run,
                      " pair results missing (" + missing + (missing_count > 10 ? ", ..." : "") +
                      "); run or rerun the shards that own them");
   }
-  return records;
+  return results;
 }
 
 std::string RunManifestPath(const std::string& out_dir) {

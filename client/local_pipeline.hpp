@@ -26,8 +26,10 @@ namespace boicp::cli {
 struct MapSettings : settings::RequestedSettings {
   std::string path;  // scan folder (made absolute)
   std::string layout = "auto";
-  std::string pairing = "consecutive";  // consecutive | overlap | explicit
+  std::string pairing = "consecutive";  // PairingModeName: consecutive | overlap | explicit
   std::string pairs_file;               // explicit pairing: "source,target" lines
+  double overlap_threshold = 0.0;       // overlap pairing; 0 = BatchOverlapThreshold
+  std::string extra_pairs_file;         // loop closures besides the pairing's own, same lines
   int first = 0, stride = 1, count = 0;
   std::string intrinsics;  // "fx,fy,cx,cy"
   std::string camera;      // TUM fr1|fr2|fr3
@@ -50,9 +52,8 @@ struct LocalRun {
   std::vector<MeasuredScan> measured;      // the scans it chose them from
   SensorKind sensor = SensorKind::kOther;  // the sensor it took them for, when it measured
   std::string sensor_reason;               // and why
-  bool keyframes = false;                  // overlap pairing
-  double overlap_threshold = 0;            // keyframes only
-  std::vector<PairIndex> plan;             // consecutive or explicit pairs; empty for keyframes
+  PairingRequest pairing;                  // as the settings ask, pairs read from their files
+  PairingPlan plan;                        // PlanPairing of `pairing`
 };
 
 /// Reads the folder and validates everything (config, map settings,
@@ -87,7 +88,7 @@ std::vector<PairIndex> ReadPairsFile(const std::string& path);
 /// The stored results of `pairs`, each from the first of `dirs` whose
 /// pairs/ holds it, checked against the run's settings. Throws InputError
 /// naming the missing pairs or the first file with other settings.
-std::map<PairIndex, PairRecord> ReadStoredPairs(const LocalRun& run,
+std::map<PairIndex, PairResult> ReadStoredPairs(const LocalRun& run,
                                                 const std::vector<PairIndex>& pairs,
                                                 const std::vector<std::string>& dirs);
 
@@ -102,8 +103,8 @@ MapSettings ReadRunManifest(const std::string& dir);
 /// config: A vs C"); empty when they agree.
 std::string ManifestDifferences(const MapSettings& a, const MapSettings& b);
 
-/// The run's pairing plan for core's map pipeline: run.plan chained, or
-/// keyframes by overlap.
-PairingPlan RunPlan(const LocalRun& run);
+/// Every pair of a fixed plan, its chain then its extras (a shard's share
+/// and a merge's pairs are counted in this order).
+std::vector<PairIndex> FixedPlanPairs(const PairingPlan& plan);
 
 }  // namespace boicp::cli

@@ -69,21 +69,22 @@ void ClaimShardManifest(const LocalRun& run, const std::string& out) {
 // writes only their files and the manifest; `boicp merge` builds the map.
 int RunShard(const LocalRun& run, const Shard& shard, const MapFlags& flags) {
   const std::string& out = flags.out_dir;
+  const std::vector<PairIndex> all = FixedPlanPairs(run.plan);
   std::vector<PairIndex> mine;
-  for (size_t i = 0; i < run.plan.size(); ++i) {
+  for (size_t i = 0; i < all.size(); ++i) {
     if (static_cast<int>(i % static_cast<size_t>(shard.count)) == shard.index - 1) {
-      mine.push_back(run.plan[i]);
+      mine.push_back(all[i]);
     }
   }
   std::fprintf(stderr, "shard %d/%d: %zu of %zu pairs\n", shard.index, shard.count, mine.size(),
-               run.plan.size());
+               all.size());
   const int reused = RegisterLocalPairs(run, mine, out, flags.threads);
   std::fprintf(stderr, "shard %d/%d done; when every shard is, run: boicp merge %s -o OUTDIR\n",
                shard.index, shard.count, out.c_str());
   if (flags.json) {
     std::cout << json{{"shard", flags.shard},
                       {"pairs", mine.size()},
-                      {"pairs_total", run.plan.size()},
+                      {"pairs_total", all.size()},
                       {"pairs_reused", reused},
                       {"pairs_dir", (fs::path(out) / "pairs").string()}}
                      .dump()
@@ -132,11 +133,12 @@ int RunMap(MapFlags flags) {
     MapSettings settings = ResolveMapSettings(flags.map);
     settings.path = Absolute(settings.path);
     settings.pairs_file = Absolute(settings.pairs_file);
+    settings.extra_pairs_file = Absolute(settings.extra_pairs_file);
     LocalRun run = PrepareRun(settings);
     const std::string& out = flags.out_dir;
     const bool sharded = !flags.shard.empty();
     const Shard shard = sharded ? ParseShard(flags.shard) : Shard{};
-    if (sharded && run.keyframes) {
+    if (sharded && run.plan.keyframes) {
       throw InputError(
           "--shard: overlap pairing chooses its pairs as results come in; shard "
           "consecutive or explicit pairing");

@@ -23,6 +23,13 @@ void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Front
                  "'source,target' scan indices)")
       ->expected(1, -1)
       ->default_str("consecutive");
+  app.add_option("--overlap-threshold", s.overlap_threshold,
+                 "Overlap pairing: a scan that overlaps the current keyframe by less starts the "
+                 "next keyframe, in (0, 1]; 0 = 0.6 for depth images, 0.7 otherwise")
+      ->capture_default_str();
+  app.add_option("--extra-pairs", s.extra_pairs_file,
+                 "Consecutive or overlap pairing: FILE of 'source,target' scan indices "
+                 "registered besides (loop closures, weighed in a pose graph)");
   settings::AddSettingFlags(app, frontend, s, flags.setting_texts);
   app.add_option("--first", s.first, "Index of the first scan kept")->capture_default_str();
   app.add_option("--stride", s.stride, "Keep every N-th scan")->capture_default_str();

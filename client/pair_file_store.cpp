@@ -22,62 +22,38 @@ std::optional<PairIndex> PairOfFileName(const std::string& name) {
 
 }  // namespace
 
-FinishedPair FinishedFromRecord(const PairRecord& record) {
-  const PairConstraint edge = RecordConstraint(record);
-  FinishedPair finished;
-  finished.pair = record.pair;
-  finished.transform = edge.T_target_source;
-  finished.information = edge.information;
-  finished.confidence = edge.confidence;
-  finished.planner_overlap = PlannerOverlap(record);
-  finished.search_reach = record.search_reach.value_or(0.0);
-  finished.doubtful = IsDoubtful(record);
-  return finished;
-}
-
 PairFileStore::PairFileStore(const std::vector<ScanSource>& scans, const BoIcpConfig& config,
                              std::string out_dir)
     : scans_(scans), config_(config), out_dir_(std::move(out_dir)) {}
 
-std::vector<FinishedPair> PairFileStore::LoadFinished() {
-  std::vector<FinishedPair> finished;
+std::vector<PairResult> PairFileStore::LoadFinished() {
+  std::vector<PairResult> finished;
   const fs::path dir = fs::path(out_dir_) / "pairs";
   std::error_code error;
   if (!fs::is_directory(dir, error)) return finished;
   const int n = static_cast<int>(scans_.size());
-  std::lock_guard<std::mutex> lock(mutex_);
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
     const std::optional<PairIndex> pair = PairOfFileName(entry.path().filename().string());
     if (!pair || pair->source >= n || pair->target >= n || pair->source == pair->target) continue;
-    std::optional<PairRecord> record;
+    std::optional<PairFile> file;
     try {
-      record = ReadPairFile(out_dir_, *pair);
+      file = ReadPairFile(out_dir_, *pair);
     } catch (const NewerPairFileError&) {
       throw;  // a newer boicp's answer: not ours to overwrite
     } catch (const InputError&) {
       continue;  // unreadable: registered again and overwritten
     }
-    if (!record || record->settings != PairSettings(scans_, *pair, config_)) continue;
-    finished.push_back(FinishedFromRecord(*record));
-    records_[*pair] = std::move(*record);
+    if (!file || file->settings != PairSettings(scans_, *pair, config_)) continue;
+    finished.push_back(std::move(file->result));
   }
   return finished;
 }
 
-void PairFileStore::Save(const PairIndex& pair, int /*listing_order*/,
-                         const BatchPairResult& result) {
-  PairRecord record = MakePairRecord(scans_, pair, result, PairSettings(scans_, pair, config_));
-  WritePairFile(out_dir_, record);
-  std::lock_guard<std::mutex> lock(mutex_);
-  records_[pair] = std::move(record);
+void PairFileStore::Save(int /*listing_order*/, const PairResult& result) {
+  WritePairFile(out_dir_, scans_, result, PairSettings(scans_, result.pair, config_));
 }
 
 // pairs.json carries in_graph; the pair files themselves do not.
 void PairFileStore::MarkInGraph(const std::vector<PairIndex>& /*in_graph*/) {}
-
-PairRecord PairFileStore::Record(const PairIndex& pair) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return records_.at(pair);
-}
 
 }  // namespace boicp::cli

@@ -4,9 +4,6 @@
 // each pair finishes. A file is reused only when its settings match the
 // run's exactly; anything else is registered again and overwritten.
 
-#include <map>
-#include <mutex>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -23,22 +20,14 @@ class PairFileStore : public PairStore {
 
   /// Every readable file in OUTDIR/pairs whose pair lies within the scans
   /// and whose settings match the run's.
-  std::vector<FinishedPair> LoadFinished() override;
-  void Save(const PairIndex& pair, int listing_order, const BatchPairResult& result) override;
+  std::vector<PairResult> LoadFinished() override;
+  void Save(int listing_order, const PairResult& result) override;
   void MarkInGraph(const std::vector<PairIndex>& in_graph) override;
-
-  /// The record of a loaded or saved pair. Throws std::out_of_range for another.
-  PairRecord Record(const PairIndex& pair) const;
 
  private:
   const std::vector<ScanSource>& scans_;
   const BoIcpConfig& config_;
   const std::string out_dir_;
-  mutable std::mutex mutex_;  // Save runs on worker threads
-  std::map<PairIndex, PairRecord> records_;
 };
-
-/// The pose-graph view of a record (RecordConstraint, PlannerOverlap, IsDoubtful).
-FinishedPair FinishedFromRecord(const PairRecord& record);
 
 }  // namespace boicp::cli

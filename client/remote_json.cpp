@@ -2,7 +2,9 @@
 
 #include <cstdio>
 
+#include "boicp/rpc/pair_result_proto.hpp"
 #include "boicp/rpc/settings_proto.hpp"
+#include "boicp/settings/pair_result_json.hpp"
 #include "boicp/settings/settings_json.hpp"
 #include "json_output.hpp"
 
@@ -71,26 +73,10 @@ nlohmann::json JobToJson(const v1::Job& job) {
 }
 
 nlohmann::json PairToJson(const v1::PairResult& pair) {
-  return {
-      {"source", pair.source()},
-      {"target", pair.target()},
-      {"source_scan_id", pair.source_scan_id()},
-      {"target_scan_id", pair.target_scan_id()},
-      {"transform", TransformToJson(rpc::TransformFromProto(pair.transform(), "pair.transform"))},
-      {"objective", pair.objective()},
-      {"fitness", pair.fitness()},
-      {"inlier_rmse", pair.inlier_rmse()},
-      {"confidence", pair.confidence()},
-      {"doubtful", pair.doubtful()},
-      {"overlap", pair.has_overlap() ? nlohmann::json(pair.overlap()) : nlohmann::json(nullptr)},
-      {"search_reach",
-       pair.has_search_reach() ? nlohmann::json(pair.search_reach()) : nlohmann::json(nullptr)},
-      {"answered_by", rpc::AnsweredBy(pair)},
-      {"evaluations", pair.evaluations()},
-      {"runtime_s", pair.runtime_s()},
-      {"finished_at", pair.finished_at()},
-      {"seed", pair.seed()},
-      {"in_graph", pair.in_graph()}};
+  nlohmann::json out = settings::PairResultToJson(rpc::PairResultFromProto(pair), kPairApi);
+  out["source_scan_id"] = pair.source_scan_id();
+  out["target_scan_id"] = pair.target_scan_id();
+  return out;
 }
 
 nlohmann::json ResultsToJson(const v1::JobResults& results) {

@@ -26,12 +26,10 @@ std::string DescribeChosenSettings(const v1::ChosenSettings& settings);
 
 nlohmann::json JobToJson(const v1::Job& job);
 
-/// {"source", "target", "source_scan_id", "target_scan_id", "transform"
-///  (T_target_source), "objective", "fitness", "inlier_rmse", "confidence",
-///  "doubtful" (false when the daemon stored none), "overlap" and
-///  "search_reach" (null when unknown), "answered_by" (rpc::AnsweredBy),
-///  "evaluations" (of every rung), "runtime_s",
-///  "finished_at", "seed", "in_graph"}.
+/// The pair's kPairApi fields (settings::PairResultToJson: "source",
+/// "target", "transform" as T_target_source, "confidence", "doubtful",
+/// "answered_by", "finished_at", "in_graph", ...) and its "source_scan_id"
+/// and "target_scan_id". Throws InputError for a malformed message.
 nlohmann::json PairToJson(const v1::PairResult& pair);
 
 /// The job's fields plus "pairs" (in plan order) and "trajectory"

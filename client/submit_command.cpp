@@ -32,21 +32,7 @@ struct SubmitFlags {
 v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
   const MapSettings& s = run.settings;
   v1::SubmitBatchRequest request;
-  v1::PairingPolicy& pairing = *request.mutable_pairing();
-  if (run.keyframes) {
-    pairing.set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
-    pairing.set_overlap_threshold(run.overlap_threshold);
-  } else {
-    pairing.set_mode(s.pairing == "explicit" ? v1::PairingPolicy::MODE_EXPLICIT
-                                             : v1::PairingPolicy::MODE_CONSECUTIVE);
-    if (s.pairing == "explicit") {
-      for (const PairIndex& p : run.plan) {
-        v1::Pair* pair = pairing.add_pairs();
-        pair->set_source(static_cast<uint32_t>(p.source));
-        pair->set_target(static_cast<uint32_t>(p.target));
-      }
-    }
-  }
+  *request.mutable_pairing() = rpc::PairingToProto(run.pairing);
   *request.mutable_config() = rpc::RegistrationConfigToProto(s);
   // The map settings PrepareRun leaves to the daemon (sensor model, cloud
   // voxel) are checked here too, before any upload.

@@ -23,7 +23,7 @@ PairProgress::PairProgress(int total)
 
 void PairProgress::SetTotal(int total) { total_ = total; }
 
-void PairProgress::Done(const PairRecord& record, bool reused) {
+void PairProgress::Done(const PairResult& result, bool reused) {
   ++done_;
   if (!reused) ++registered_;
   const double elapsed = NowSeconds() - started_;
@@ -37,9 +37,9 @@ void PairProgress::Done(const PairRecord& record, bool reused) {
                  std::string(kWidth - filled, '.').c_str(), done_, total_, eta.c_str());
   } else {
     std::fprintf(stderr, "pair %s %s (%d/%d): fitness %.3f, confidence %.2f%s, %.1f s, ETA %s\n",
-                 PairName(record.pair).c_str(), reused ? "reused" : "done", done_, total_,
-                 record.fitness, record.confidence, IsDoubtful(record) ? " (doubtful)" : "",
-                 record.runtime_s, eta.c_str());
+                 PairName(result.pair).c_str(), reused ? "reused" : "done", done_, total_,
+                 result.fitness, result.confidence, result.doubtful ? " (doubtful)" : "",
+                 result.runtime_s, eta.c_str());
   }
   std::fflush(stderr);
 }
@@ -50,11 +50,10 @@ void PairProgress::Finish() {
                done_ - registered_, FormatDuration(NowSeconds() - started_).c_str());
 }
 
-void TerminalProgress::PairFinished(const FinishedPair& pair, bool reused,
-                                    const PairCounts& counts) {
+void TerminalProgress::PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) {
   reported_ = true;
   pairs_.SetTotal(counts.total);
-  pairs_.Done(store_.Record(pair.pair), reused);
+  pairs_.Done(pair, reused);
 }
 
 void TerminalProgress::StageStarted(const std::string& /*stage*/, int /*total*/) {

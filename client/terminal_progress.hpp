@@ -3,7 +3,6 @@
 // line per pair otherwise, then the fusion stage.
 
 #include "boicp/mapping/map_progress.hpp"
-#include "pair_file_store.hpp"
 
 namespace boicp::cli {
 
@@ -13,7 +12,7 @@ class PairProgress {
   explicit PairProgress(int total);
   void SetTotal(int total);
   /// A pair finished (reused: its file was already there).
-  void Done(const PairRecord& record, bool reused);
+  void Done(const PairResult& result, bool reused);
   void Finish();
   int reused() const { return done_ - registered_; }
 
@@ -28,10 +27,9 @@ class PairProgress {
 /// The map pipeline's progress sink for `boicp map`, `--shard` and `merge`.
 class TerminalProgress : public MapProgressSink {
  public:
-  /// `store` (for each pair's figures) must outlive this.
-  explicit TerminalProgress(const PairFileStore& store) : store_(store), pairs_(0) {}
+  TerminalProgress() : pairs_(0) {}
 
-  void PairFinished(const FinishedPair& pair, bool reused, const PairCounts& counts) override;
+  void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override;
   void StageStarted(const std::string& stage, int total) override;
   void AssemblyStep(const AssemblyProgress& progress) override;
 
@@ -40,7 +38,6 @@ class TerminalProgress : public MapProgressSink {
   int reused() const { return pairs_.reused(); }
 
  private:
-  const PairFileStore& store_;
   PairProgress pairs_;
   bool reported_ = false;  // a pair was reported
   bool pairs_finished_ = false;

@@ -133,9 +133,9 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   job.set_state(v1::JOB_STATE_QUEUED);
   job.set_stage("queued");
   job.set_num_scans(static_cast<uint32_t>(request.scan_ids_size()));
-  const size_t planned = spec.pairing == PairingMode::kKeyframes
-                             ? spec.scans.size() - 1 + spec.extra_pairs.size()
-                             : spec.base_pairs.size() + spec.extra_pairs.size();
+  // A keyframe plan registers at least one pair per scan after the first.
+  const size_t planned = (spec.plan.keyframes ? spec.scans.size() - 1 : spec.plan.chain.size()) +
+                         spec.plan.extras.size();
   job.set_pairs_total(static_cast<uint32_t>(planned));
   job.set_eta_seconds(-1.0);
   job.set_created_at(rpc::NowSeconds());

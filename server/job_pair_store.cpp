@@ -1,22 +1,30 @@
 #include "job_pair_store.hpp"
 
-#include "pair_result_proto.hpp"
+#include "boicp/rpc/pair_result_proto.hpp"
+#include "boicp/rpc/proto_convert.hpp"
 
 namespace boicp::server {
 
-std::vector<FinishedPair> JobPairStore::LoadFinished() {
-  std::vector<FinishedPair> finished;
+std::vector<PairResult> JobPairStore::LoadFinished() {
+  std::vector<PairResult> finished;
   std::lock_guard<std::mutex> lock(mutex_);
   for (StoredPair& stored : store_.GetPairs(spec_.job_id)) {
-    finished.push_back(FinishedFromProto(stored.result, stored.information));
+    finished.push_back(rpc::PairResultFromProto(stored.result));
+    finished.back().information = stored.information;
     results_[finished.back().pair] = std::move(stored.result);
   }
   return finished;
 }
 
-void JobPairStore::Save(const PairIndex& pair, int listing_order, const BatchPairResult& result) {
-  v1::PairResult proto = PairResultToProto(spec_, pair, result);
-  store_.PutPair(spec_.job_id, listing_order, proto, result.registration.information);
+void JobPairStore::Save(int listing_order, const PairResult& result) {
+  const PairIndex& pair = result.pair;
+  PairResult finished = result;
+  finished.finished_at = rpc::NowSeconds();
+  v1::PairResult proto;
+  rpc::PairResultToProto(finished, &proto);
+  proto.set_source_scan_id(spec_.scan_ids.at(static_cast<size_t>(pair.source)));
+  proto.set_target_scan_id(spec_.scan_ids.at(static_cast<size_t>(pair.target)));
+  store_.PutPair(spec_.job_id, listing_order, proto, result.information);
   std::lock_guard<std::mutex> lock(mutex_);
   results_[pair] = std::move(proto);
 }

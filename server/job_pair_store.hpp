@@ -19,8 +19,8 @@ class JobPairStore : public PairStore {
   /// `store` and `spec` must outlive this.
   JobPairStore(JobStore& store, const JobSpec& spec) : store_(store), spec_(spec) {}
 
-  std::vector<FinishedPair> LoadFinished() override;
-  void Save(const PairIndex& pair, int listing_order, const BatchPairResult& result) override;
+  std::vector<PairResult> LoadFinished() override;
+  void Save(int listing_order, const PairResult& result) override;
   void MarkInGraph(const std::vector<PairIndex>& in_graph) override;
 
   /// The stored result of `pair` as the API reports it; nullopt when none is stored.

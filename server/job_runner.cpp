@@ -37,25 +37,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr auto kProgressInterval = std::chrono::seconds(1);
 
-const char* PairingName(PairingMode pairing) {
-  switch (pairing) {
-    case PairingMode::kConsecutive:
-      return "consecutive";
-    case PairingMode::kKeyframes:
-      return "keyframe";
-    case PairingMode::kExplicit:
-      return "explicit";
-  }
-  return "unknown";
-}
-
-PairingPlan JobPlan(const JobSpec& spec) {
-  if (spec.pairing == PairingMode::kKeyframes) {
-    return PlanKeyframes(spec.overlap_threshold, spec.extra_pairs);
-  }
-  return PlanFixedPairs(spec.base_pairs, spec.extra_pairs);
-}
-
 // One run of a job: core's map pipeline with the job's rows in the job store
 // as its pair store, and this class as its progress sink (the job record,
 // persisted and published to watchers). What stays here is the job's
@@ -121,7 +102,7 @@ class JobRun : public MapProgressSink {
     batch_.map.max_fusion_bytes = ctx_.max_fusion_bytes;
     RequireFusionWithinLimit(batch_.scans, ScanProfiles(), batch_.map.occupancy,
                              ctx_.max_fusion_bytes);
-    batch_.plan = JobPlan(batch_spec_);
+    batch_.plan = batch_spec_.plan;
     job_.set_state(v1::JOB_STATE_RUNNING);
     if (job_.started_at() == 0.0) job_.set_started_at(rpc::NowSeconds());
     if (ctx_.max_job_seconds > 0.0) {
@@ -159,25 +140,26 @@ class JobRun : public MapProgressSink {
     Persist();
     Publish(nullptr);
     spdlog::info("job {} running: {} scans, {} pairing, preset {}, {} of {} pairs already done",
-                 job_.job_id(), batch_.scans.size(), PairingName(batch_spec_.pairing),
+                 job_.job_id(), batch_.scans.size(), PairingModeName(batch_spec_.pairing),
                  batch_.config.preset, counts.done, counts.total);
   }
 
-  void PairFinished(const FinishedPair& pair, bool reused, const PairCounts& counts) override {
+  void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
     if (reused) return;  // counted by RegistrationStarted
     ++done_this_run_;
     last_done_ = Clock::now();
     SetCounts(counts);
     Persist();
-    const std::optional<v1::PairResult> r = pairs_->Result(pair.pair);
-    if (!r) throw std::logic_error("a finished pair is missing from the job's pair store");
     spdlog::info(
         "job {} pair {} done in {:.2f} s ({}/{}): fitness {:.3f}, confidence {:.3f}{}, "
         "objective {:.4f} m, answered by {} in {} evaluations",
-        job_.job_id(), PairName(pair.pair), r->runtime_s(), job_.pairs_done(), job_.pairs_total(),
-        r->fitness(), r->confidence(), r->doubtful() ? " (doubtful)" : "", r->objective(),
-        r->answered_by(), r->evaluations());
-    Publish(&*r);
+        job_.job_id(), PairName(pair.pair), pair.runtime_s, job_.pairs_done(), job_.pairs_total(),
+        pair.fitness, pair.confidence, pair.doubtful ? " (doubtful)" : "", pair.objective,
+        RungName(pair.answered_by), pair.evaluations);
+    // The stored message, with the scan ids and the time it was stored.
+    const std::optional<v1::PairResult> stored = pairs_->Result(pair.pair);
+    if (!stored) throw std::logic_error("a finished pair is missing from the job's pair store");
+    Publish(&*stored);
   }
 
   void PairFailed(const PairIndex& pair, const std::string& message) override {

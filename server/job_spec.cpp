@@ -10,17 +10,6 @@
 #include "job_limits.hpp"
 
 namespace boicp::server {
-namespace {
-
-std::vector<PairIndex> PairsFromProto(const v1::PairingPolicy& pairing) {
-  std::vector<PairIndex> pairs;
-  for (const v1::Pair& p : pairing.pairs()) {
-    pairs.push_back({static_cast<int>(p.source()), static_cast<int>(p.target())});
-  }
-  return pairs;
-}
-
-}  // namespace
 
 BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads) {
   try {
@@ -70,40 +59,9 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
   }
 
   spec.config = ConfigFromProto(request.config(), registration_threads);
-  const v1::PairingPolicy& pairing = request.pairing();
-  const std::vector<PairIndex> listed = PairsFromProto(pairing);
-  switch (pairing.mode()) {
-    case v1::PairingPolicy::MODE_UNSPECIFIED:
-    case v1::PairingPolicy::MODE_CONSECUTIVE: {
-      spec.pairing = PairingMode::kConsecutive;
-      spec.base_pairs = ConsecutivePairs(n);
-      spec.extra_pairs = listed;
-      std::vector<PairIndex> all = spec.base_pairs;
-      all.insert(all.end(), listed.begin(), listed.end());
-      ValidatePairs(n, all, /*require_connected=*/true);
-      break;
-    }
-    case v1::PairingPolicy::MODE_KEYFRAMES: {
-      spec.pairing = PairingMode::kKeyframes;
-      const double threshold = pairing.overlap_threshold();
-      if (threshold != 0.0 && !(threshold > 0.0 && threshold <= 1.0)) {
-        throw InputError("pairing.overlap_threshold must be in (0, 1] (0 = default)");
-      }
-      spec.overlap_threshold =
-          threshold != 0.0 ? threshold : BatchOverlapThreshold(spec.scans, spec.config.sensor);
-      spec.extra_pairs = listed;
-      ValidatePairs(n, listed, /*require_connected=*/false);
-      break;
-    }
-    case v1::PairingPolicy::MODE_EXPLICIT:
-      spec.pairing = PairingMode::kExplicit;
-      if (listed.empty()) throw InputError("pairing.pairs: explicit pairing needs pairs");
-      spec.base_pairs = listed;
-      ValidatePairs(n, listed, /*require_connected=*/true);
-      break;
-    default:
-      throw InputError("pairing.mode: unknown mode " + std::to_string(pairing.mode()));
-  }
+  const PairingRequest pairing = rpc::PairingFromProto(request.pairing());
+  spec.pairing = pairing.mode;
+  spec.plan = PlanPairing(pairing, spec.scans, spec.config.sensor);
   spec.map = MapSettingsFromProto(request.map());
   spec.map_auto =
       settings::MapAutoFromSettings(rpc::SettingsFromProto(request.config(), request.map()));

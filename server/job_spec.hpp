@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/registration/config.hpp"
@@ -18,17 +19,13 @@ namespace boicp::server {
 
 namespace v1 = ::boicp::v1;
 
-enum class PairingMode { kConsecutive, kKeyframes, kExplicit };
-
 struct JobSpec {
   std::string job_id;
   std::vector<std::string> scan_ids;
   std::vector<ScanSource> scans;
-  PairingMode pairing = PairingMode::kConsecutive;
-  double overlap_threshold = 0.7;      // kKeyframes only
-  std::vector<PairIndex> base_pairs;   // consecutive or explicit pairs; empty for keyframes
-  std::vector<PairIndex> extra_pairs;  // loop closures on top of the policy's pairs
-  BoIcpConfig config;                  // config.seed is the job seed
+  PairingMode pairing = PairingMode::kConsecutive;  // as asked
+  PairingPlan plan;                                 // PlanPairing of the request
+  BoIcpConfig config;                               // config.seed is the job seed
   MapBuildSettings map;
   MapAutoFields map_auto;  // map settings still to be chosen from the scans
 };

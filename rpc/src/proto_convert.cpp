@@ -1,7 +1,9 @@
 #include "boicp/rpc/proto_convert.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -19,6 +21,13 @@ constexpr std::pair<CloudFormat, v1::ScanFormat> kScanFormats[] = {
     {CloudFormat::kPly, v1::SCAN_FORMAT_PLY},
     {CloudFormat::kXyz, v1::SCAN_FORMAT_XYZ},
     {CloudFormat::kDepthPng, v1::SCAN_FORMAT_DEPTH_PNG},
+};
+
+// Every pairing mode with its API value (MODE_UNSPECIFIED reads as consecutive).
+constexpr std::pair<PairingMode, v1::PairingPolicy::Mode> kPairingModes[] = {
+    {PairingMode::kConsecutive, v1::PairingPolicy::MODE_CONSECUTIVE},
+    {PairingMode::kOverlap, v1::PairingPolicy::MODE_KEYFRAMES},
+    {PairingMode::kExplicit, v1::PairingPolicy::MODE_EXPLICIT},
 };
 
 }  // namespace
@@ -143,6 +152,36 @@ void ValidateScanMetadata(const v1::ScanMetadata& metadata) {
   if (!metadata.sha256().empty() && !IsSha256Hex(metadata.sha256())) {
     throw InputError("metadata.sha256 must be 64 lowercase hex digits");
   }
+}
+
+PairingRequest PairingFromProto(const v1::PairingPolicy& proto) {
+  PairingRequest pairing;
+  const auto known = std::find_if(std::begin(kPairingModes), std::end(kPairingModes),
+                                  [&](const auto& entry) { return entry.second == proto.mode(); });
+  if (known != std::end(kPairingModes)) {
+    pairing.mode = known->first;
+  } else if (proto.mode() != v1::PairingPolicy::MODE_UNSPECIFIED) {
+    throw InputError("pairing.mode: unknown mode " + std::to_string(proto.mode()));
+  }
+  pairing.overlap_threshold = proto.overlap_threshold();
+  for (const v1::Pair& p : proto.pairs()) {
+    pairing.pairs.push_back({static_cast<int>(p.source()), static_cast<int>(p.target())});
+  }
+  return pairing;
+}
+
+v1::PairingPolicy PairingToProto(const PairingRequest& pairing) {
+  v1::PairingPolicy proto;
+  for (const auto& [mode, value] : kPairingModes) {
+    if (mode == pairing.mode) proto.set_mode(value);
+  }
+  proto.set_overlap_threshold(pairing.overlap_threshold);
+  for (const PairIndex& p : pairing.pairs) {
+    v1::Pair* pair = proto.add_pairs();
+    pair->set_source(static_cast<uint32_t>(p.source));
+    pair->set_target(static_cast<uint32_t>(p.target));
+  }
+  return proto;
 }
 
 std::string AnsweredBy(const v1::PairResult& pair) {

@@ -413,6 +413,15 @@ TEST_F(MapCli, BadInputGivesOneLineErrorExitCode2AndNoMap) {
        "split.csv"},
       {"map " + scans.string() + out + " --pairing explicit " + (dir_ / "bad.csv").string(),
        "bad.csv:1"},
+      {"map " + scans.string() + out + " --extra-pairs " + (dir_ / "split.csv").string(),
+       "split.csv: pair 2 (0->1): the same two scans are already paired"},
+      {"map " + scans.string() + out + " --pairing explicit " + (dir_ / "split.csv").string() +
+           " --extra-pairs " + (dir_ / "split.csv").string(),
+       "--extra-pairs: explicit pairing lists every pair in its FILE"},
+      {"map " + scans.string() + out + " --overlap-threshold 0.5",
+       "--overlap-threshold: only overlap pairing has one"},
+      {"map " + scans.string() + out + " --pairing overlap --overlap-threshold 1.5",
+       "overlap_threshold must be in (0, 1]"},
       {"map " + scans.string() + out + " --count 1", "at least 2 scans"},
       {"map " + scans.string() + out + " --resolution -1", "resolution"},
       {"map " + scans.string() + out + " --config Z", "Z"},
@@ -515,7 +524,16 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
   // Explicit: the chain plus one loop closure, so the pose graph is optimised.
   const fs::path pairs_file = dir_ / "pairs.csv";
   std::ofstream(pairs_file) << "source,target\n0,1\n1,2\n2,3\n3,4\n4,5\n4,2\n";
-  std::vector<PairingCase> cases(3);
+  // The other modes take loop closures besides their own pairs, and overlap
+  // pairing a threshold, in both front ends.
+  const fs::path closure_file = dir_ / "closure.csv";
+  std::ofstream(closure_file) << "5,1\n";
+  const auto add_pair = [](v1::PairingPolicy& pairing, int source, int target) {
+    v1::Pair* pair = pairing.add_pairs();
+    pair->set_source(static_cast<uint32_t>(source));
+    pair->set_target(static_cast<uint32_t>(target));
+  };
+  std::vector<PairingCase> cases(5);
   cases[0].name = "consecutive";
   cases[0].cli_flags = "consecutive";
   cases[0].pairing.set_mode(v1::PairingPolicy::MODE_CONSECUTIVE);
@@ -527,10 +545,17 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
   cases[2].pairing.set_mode(v1::PairingPolicy::MODE_EXPLICIT);
   for (const auto& [source, target] :
        std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 5}, {4, 2}}) {
-    v1::Pair* pair = cases[2].pairing.add_pairs();
-    pair->set_source(static_cast<uint32_t>(source));
-    pair->set_target(static_cast<uint32_t>(target));
+    add_pair(cases[2].pairing, source, target);
   }
+  cases[3].name = "consecutive-with-a-closure";
+  cases[3].cli_flags = "consecutive --extra-pairs " + closure_file.string();
+  cases[3].pairing.set_mode(v1::PairingPolicy::MODE_CONSECUTIVE);
+  add_pair(cases[3].pairing, 5, 1);
+  cases[4].name = "overlap-at-0.8-with-a-closure";
+  cases[4].cli_flags = "overlap --overlap-threshold 0.8 --extra-pairs " + closure_file.string();
+  cases[4].pairing.set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  cases[4].pairing.set_overlap_threshold(0.8);
+  add_pair(cases[4].pairing, 5, 1);
 
   test::DaemonProcess daemon(
       {"--data-dir", (dir_ / "daemon").string(), "--workers", "2", "--registration-threads", "1"},
@@ -600,6 +625,9 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
     }
     EXPECT_EQ(local_in_graph, remote_in_graph);
     EXPECT_GE(local_in_graph.size(), truth_.size() - 1);
+    if (pairing.name.find("closure") != std::string::npos) {
+      EXPECT_EQ(local_pairs.count({5, 1}), 1u) << "the loop closure was registered";
+    }
     if (pairing.name == "overlap") {
       // The street overlaps well from any distance, but the scans soon lie
       // past half of keyframe 0's search box: a later keyframe takes over.

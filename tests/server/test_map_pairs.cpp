@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/mapping/map_up.hpp"
 #include "boicp/util/types.hpp"
@@ -41,6 +41,70 @@ TEST(MapPairs, ValidatePairsNamesTheProblem) {
               HasSubstr("do not connect scan 2"));
   EXPECT_EQ(ErrorOf([] { ValidatePairs(4, {{0, 1}, {2, 3}}, false); }), "");
   EXPECT_EQ(ErrorOf([] { ValidatePairs(4, {{1, 0}, {2, 1}, {3, 0}}, true); }), "");
+}
+
+// One request, one plan, whichever front end asked: the same checks and the
+// same extra pairs for the daemon and `boicp map`.
+TEST(MapPairs, APairingRequestPlansEveryModeWithItsExtraPairs) {
+  std::vector<ScanSource> scans(4);
+  for (ScanSource& scan : scans) scan.load.format = CloudFormat::kPcd;
+  PairingRequest consecutive;
+  consecutive.pairs = {{3, 0}};
+  const PairingPlan chained = PlanPairing(consecutive, scans, std::nullopt);
+  EXPECT_FALSE(chained.keyframes);
+  EXPECT_EQ(chained.chain, ConsecutivePairs(4));
+  EXPECT_THAT(chained.extras, ElementsAre(PairIndex{3, 0}));
+
+  PairingRequest overlap;
+  overlap.mode = PairingMode::kOverlap;
+  overlap.pairs = {{3, 1}};
+  const PairingPlan keyframes = PlanPairing(overlap, scans, std::nullopt);
+  EXPECT_TRUE(keyframes.keyframes);
+  EXPECT_DOUBLE_EQ(keyframes.overlap_threshold, 0.7);
+  EXPECT_THAT(keyframes.extras, ElementsAre(PairIndex{3, 1}));
+  overlap.overlap_threshold = 0.45;
+  EXPECT_DOUBLE_EQ(PlanPairing(overlap, scans, std::nullopt).overlap_threshold, 0.45);
+
+  PairingRequest listed;
+  listed.mode = PairingMode::kExplicit;
+  listed.pairs = {{1, 0}, {2, 1}, {3, 2}, {3, 0}};
+  const PairingPlan fixed = PlanPairing(listed, scans, std::nullopt);
+  EXPECT_EQ(fixed.chain, listed.pairs);
+  EXPECT_TRUE(fixed.extras.empty());
+}
+
+TEST(MapPairs, APairingRequestNamesWhatIsWrongAndWhereThePairsCameFrom) {
+  const std::vector<ScanSource> scans(3);
+  PairingRequest repeated;
+  repeated.pairs = {{1, 0}};  // consecutive already pairs 0 and 1
+  EXPECT_THAT(ErrorOf([&] { PlanPairing(repeated, scans, std::nullopt); }),
+              HasSubstr("pairing.pairs: pair 2 (1->0): the same two scans are already paired"));
+  PairingRequest threshold;
+  threshold.mode = PairingMode::kOverlap;
+  threshold.overlap_threshold = 1.5;
+  EXPECT_THAT(ErrorOf([&] { PlanPairing(threshold, scans, std::nullopt); }),
+              HasSubstr("pairing.overlap_threshold must be in (0, 1]"));
+  PairingRequest unconnected;
+  unconnected.mode = PairingMode::kExplicit;
+  unconnected.pairs = {{0, 1}};
+  EXPECT_THAT(ErrorOf([&] { PlanPairing(unconnected, scans, std::nullopt, "pairs.txt"); }),
+              HasSubstr("pairs.txt: the pairs do not connect scan 2"));
+  unconnected.pairs.clear();
+  EXPECT_THAT(ErrorOf([&] { PlanPairing(unconnected, scans, std::nullopt); }),
+              HasSubstr("explicit pairing needs pairs"));
+  // Overlap pairing connects its scans itself; its extra pairs need not.
+  PairingRequest loose;
+  loose.mode = PairingMode::kOverlap;
+  loose.pairs = {{2, 0}};
+  EXPECT_EQ(ErrorOf([&] { PlanPairing(loose, scans, std::nullopt); }), "");
+}
+
+TEST(MapPairs, PairingModesHaveOneNameEach) {
+  for (const PairingMode mode :
+       {PairingMode::kConsecutive, PairingMode::kOverlap, PairingMode::kExplicit}) {
+    EXPECT_EQ(PairingModeFromName(PairingModeName(mode)), mode);
+  }
+  EXPECT_EQ(PairingModeFromName("keyframes"), std::nullopt);
 }
 
 TEST(MapPairs, PairSeedDependsOnJobSeedAndPairOnly) {

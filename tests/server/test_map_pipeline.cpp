@@ -21,10 +21,10 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-FinishedPair Finished(int source, int target, double overlap) {
-  FinishedPair finished;
+PairResult Finished(int source, int target, double overlap) {
+  PairResult finished;
   finished.pair = {source, target};
-  finished.planner_overlap = overlap;
+  finished.overlap = overlap;
   finished.transform = Transform::Identity();
   finished.transform(0, 3) = 2.0;  // the source 2 m further along x
   return finished;
@@ -32,15 +32,15 @@ FinishedPair Finished(int source, int target, double overlap) {
 
 class MemoryStore : public PairStore {
  public:
-  explicit MemoryStore(std::vector<FinishedPair> stored) : stored_(std::move(stored)) {}
-  std::vector<FinishedPair> LoadFinished() override { return stored_; }
-  void Save(const PairIndex& pair, int, const BatchPairResult&) override {
+  explicit MemoryStore(std::vector<PairResult> stored) : stored_(std::move(stored)) {}
+  std::vector<PairResult> LoadFinished() override { return stored_; }
+  void Save(int, const PairResult& result) override {
     std::lock_guard<std::mutex> lock(mutex_);
-    saved_.push_back(pair);
+    saved_.push_back(result.pair);
   }
   void MarkInGraph(const std::vector<PairIndex>& in_graph) override { in_graph_ = in_graph; }
 
-  std::vector<FinishedPair> stored_;
+  std::vector<PairResult> stored_;
   std::mutex mutex_;
   std::vector<PairIndex> saved_;
   std::vector<PairIndex> in_graph_;
@@ -48,7 +48,7 @@ class MemoryStore : public PairStore {
 
 class RecordingProgress : public MapProgressSink {
  public:
-  void PairFinished(const FinishedPair& pair, bool reused, const PairCounts& counts) override {
+  void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
     finished.push_back(pair.pair);
     reused_count += reused;
     last = counts;
@@ -147,7 +147,7 @@ TEST(MapPipeline, AStopRequestEndsRegistrationWithCancelled) {
 
 TEST(MapPipeline, GraphEdgesAreTheChainThenExtrasNotPairingTheSameScans) {
   RegisteredPairs registered;
-  for (const FinishedPair& f :
+  for (const PairResult& f :
        {Finished(1, 0, 1), Finished(2, 1, 1), Finished(1, 2, 1), Finished(2, 0, 1)}) {
     registered.finished[f.pair] = f;
   }

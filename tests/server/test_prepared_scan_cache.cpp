@@ -116,7 +116,7 @@ TEST_F(PreparedScanCacheTest, ABatchPairFromTheCacheIsThePairFromTheRawScans) {
     const auto method = CoreMethods().Create(config.method, config);
     PreparedScanCache cache(scans_, *method, 2);
     for (const PairIndex pair : {PairIndex{0, 1}, PairIndex{1, 2}, PairIndex{0, 2}}) {
-      const BatchPairResult cached = RegisterBatchPair(scans_, pair, config, cache);
+      const PairResult cached = RegisterBatchPair(scans_, pair, config, cache);
       BoIcpConfig raw_config = config;
       raw_config.seed = cached.seed;
       const std::optional<Transform> guess = std::abs(pair.target - pair.source) == 1
@@ -124,10 +124,9 @@ TEST_F(PreparedScanCacheTest, ABatchPairFromTheCacheIsThePairFromTheRawScans) {
                                                  : std::nullopt;
       const RegistrationResult raw =
           RegisterPair(Raw(pair.source), Raw(pair.target), raw_config, std::nullopt, {}, guess);
-      EXPECT_EQ(cached.registration.transform, raw.transform)
-          << pair.source << " -> " << pair.target;
-      EXPECT_EQ(cached.registration.confidence, raw.confidence);
-      EXPECT_EQ(cached.registration.evaluations, raw.evaluations);
+      EXPECT_EQ(cached.transform, raw.transform) << pair.source << " -> " << pair.target;
+      EXPECT_EQ(cached.confidence, raw.confidence);
+      EXPECT_EQ(cached.evaluations, raw.evaluations);
     }
   }
   const ScanPyramid scan = BuildScanPyramid(Raw(0), config_);
@@ -150,7 +149,7 @@ TEST_F(PreparedScanCacheTest, AnIcpBatchRefinesEachNeighbouringPairOnceFromTheId
   PreparedScanCache cache(scans_, *method, 2);
   const SyntheticDrive drive(4, 3);
   for (const PairIndex pair : {PairIndex{0, 1}, PairIndex{1, 2}, PairIndex{2, 3}}) {
-    const RegistrationResult r = RegisterBatchPair(scans_, pair, config, cache).registration;
+    const PairResult r = RegisterBatchPair(scans_, pair, config, cache);
     const Transform truth = drive.Pose(pair.target).inverse() * drive.Pose(pair.source);
     EXPECT_EQ(r.evaluations, 1);
     EXPECT_EQ(r.answered_by, Rung::kPrior);

@@ -8,9 +8,9 @@
 
 namespace boicp {
 
-BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                                  const BoIcpConfig& job_config, PreparedScanCache& prepared,
-                                  const std::function<bool()>& stop_requested) {
+PairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                             const BoIcpConfig& job_config, PreparedScanCache& prepared,
+                             const std::function<bool()>& stop_requested) {
   const std::shared_ptr<const PreparedScan> source = prepared.Get(pair.source);
   const std::shared_ptr<const PreparedScan> target = prepared.Get(pair.target);
 
@@ -24,11 +24,9 @@ BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const Pa
   // Scans next to each other in a batch are usually a drive's consecutive
   // scans, which ICP from identity aligns: the ladder's prior rung tries it.
   if (std::abs(pair.source - pair.target) == 1) hints.guess = Transform::Identity();
-  BatchPairResult out;
-  out.seed = config.seed;
-  out.registration =
+  const RegistrationResult registration =
       CoreMethods().Create(config.method, config)->Register(*source, *target, hints, callbacks);
-  return out;
+  return MakePairResult(pair, registration, config.seed);
 }
 
 BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoIcpConfig& config,
@@ -66,15 +64,6 @@ BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoI
     choice.fields.push_back("map_max_range");
   }
   return choice;
-}
-
-double BatchOverlapThreshold(const std::vector<ScanSource>& scans,
-                             const std::optional<SensorKind>& sensor) {
-  if (sensor) return DefaultOverlapThreshold(*sensor);
-  const bool depth_images = std::all_of(scans.begin(), scans.end(), [](const ScanSource& scan) {
-    return scan.load.format == CloudFormat::kDepthPng;
-  });
-  return DefaultOverlapThreshold(depth_images ? SensorKind::kDepthCamera : SensorKind::kOther);
 }
 
 std::string DoubtfulSummary(int doubtful, int total) {

@@ -4,6 +4,8 @@
 #include <set>
 #include <utility>
 
+#include "boicp/mapping/batch_pair.hpp"
+
 namespace boicp {
 namespace {
 

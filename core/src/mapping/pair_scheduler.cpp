@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 
+#include "boicp/mapping/batch_pair.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -24,9 +25,9 @@ constexpr auto kPollInterval = std::chrono::milliseconds(100);
 // What a pair task hands back to the scheduling thread.
 struct Completion {
   PairIndex pair;
-  std::optional<FinishedPair> finished;  // set once stored
-  bool stopped = false;                  // Cancelled by a stop request or an abort
-  std::exception_ptr error;              // set on failure
+  std::optional<PairResult> finished;  // set once stored
+  bool stopped = false;                // Cancelled by a stop request or an abort
+  std::exception_ptr error;            // set on failure
 };
 
 std::string MessageOf(const std::exception_ptr& error) {
@@ -94,7 +95,7 @@ class PairScheduler {
       fixed.insert(fixed.end(), plan_.extras.begin(), plan_.extras.end());
       for (size_t i = 0; i < fixed.size(); ++i) listing_order_[fixed[i]] = static_cast<int>(i);
     }
-    for (FinishedPair& stored : store_.LoadFinished()) {
+    for (PairResult& stored : store_.LoadFinished()) {
       if (PlanUses(plan_, stored.pair)) finished_[stored.pair] = std::move(stored);
     }
     if (plan_.keyframes) {
@@ -114,7 +115,7 @@ class PairScheduler {
     next_order_ = static_cast<int>(finished_.size());
 
     // Reused pairs in listing order, so a rerun reports them as the first run did.
-    std::vector<const FinishedPair*> reused;
+    std::vector<const PairResult*> reused;
     for (const auto& entry : finished_) reused.push_back(&entry.second);
     std::stable_sort(reused.begin(), reused.end(), [this](const auto* a, const auto* b) {
       return ListingOrder(a->pair) < ListingOrder(b->pair);
@@ -122,7 +123,7 @@ class PairScheduler {
     PairCounts counts = Counts();
     counts.done = 0;
     counts.doubtful = 0;
-    for (const FinishedPair* pair : reused) {
+    for (const PairResult* pair : reused) {
       ++counts.done;
       counts.doubtful += pair->doubtful;
       progress_.PairFinished(*pair, /*reused=*/true, counts);
@@ -244,9 +245,9 @@ class PairScheduler {
       completion.stopped = true;
     } else {
       try {
-        const BatchPairResult result = RegisterBatchPair(scans_, pair, config_, prepared_, stop);
-        store_.Save(pair, order, result);
-        completion.finished = FinishedFromResult(pair, result);
+        PairResult result = RegisterBatchPair(scans_, pair, config_, prepared_, stop);
+        store_.Save(order, result);
+        completion.finished = std::move(result);
       } catch (const Cancelled&) {
         completion.stopped = true;
       } catch (...) {
@@ -270,7 +271,7 @@ class PairScheduler {
       return;
     }
     if (!completion.finished) return;
-    const FinishedPair& finished = finished_[completion.pair] = *completion.finished;
+    const PairResult& finished = finished_[completion.pair] = *completion.finished;
     if (planner_) planner_->Record(completion.pair, ProbeOutcomeOf(finished));
     progress_.PairFinished(finished, /*reused=*/false, Counts());
   }
@@ -291,7 +292,7 @@ class PairScheduler {
   PreparedScanCache prepared_;                              // shared by the pair tasks
 
   // Used on the scheduling thread only.
-  std::map<PairIndex, FinishedPair> finished_;
+  std::map<PairIndex, PairResult> finished_;
   std::optional<KeyframePlanner> planner_;
   std::deque<PairIndex> queue_;
   std::deque<PairIndex> extras_queue_;

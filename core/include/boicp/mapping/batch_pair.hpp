@@ -10,17 +10,13 @@
 
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
+#include "boicp/mapping/pair_result.hpp"
 #include "boicp/mapping/pose_graph.hpp"
 #include "boicp/mapping/prepared_scan_cache.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
 
 namespace boicp {
-
-struct BatchPairResult {
-  RegistrationResult registration;  // transform = T_target_source
-  uint64_t seed = 0;                // the pair's seed, PairSeed(job seed, pair)
-};
 
 /// Takes scans[pair.source] and scans[pair.target] from `prepared` (a cache
 /// over `scans` whose method is job_config.method with job_config) and
@@ -31,9 +27,9 @@ struct BatchPairResult {
 /// Throws Cancelled when `stop_requested` fires, InputError when a scan does
 /// not load, an index is out of range or the method is unknown,
 /// std::runtime_error for engine failures.
-BatchPairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
-                                  const BoIcpConfig& job_config, PreparedScanCache& prepared,
-                                  const std::function<bool()>& stop_requested = {});
+PairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
+                             const BoIcpConfig& job_config, PreparedScanCache& prepared,
+                             const std::function<bool()>& stop_requested = {});
 
 /// The finest search or refinement voxel accepted, as a fraction of the
 /// scans' extent: finer ones downsample nothing more, and only push voxel
@@ -74,11 +70,6 @@ struct BatchSettingsChoice {
 /// too small to choose settings from.
 BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoIcpConfig& config,
                                        OccupancySettings& occupancy, const MapAutoFields& map_auto);
-
-/// The keyframe overlap threshold of a batch: that of the `sensor` the user
-/// set, else 0.6 when every scan is a depth image and 0.7 otherwise.
-double BatchOverlapThreshold(const std::vector<ScanSource>& scans,
-                             const std::optional<SensorKind>& sensor);
 
 /// The closing line of a batch: "2 of 40 pairs doubtful" (doubtful =
 /// confidence below kDoubtfulBelow).

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "boicp/mapping/map_assembly.hpp"
-#include "boicp/mapping/pair_store.hpp"
+#include "boicp/mapping/pair_result.hpp"
 
 namespace boicp {
 
@@ -26,7 +26,7 @@ class MapProgressSink {
 
   /// A pair is finished and stored. `reused`: it came from the store
   /// (reported before registration starts), not from this run.
-  virtual void PairFinished(const FinishedPair& /*pair*/, bool /*reused*/,
+  virtual void PairFinished(const PairResult& /*pair*/, bool /*reused*/,
                             const PairCounts& /*counts*/) {}
 
   /// A pair's registration or storage failed with `message`; the pipeline

@@ -31,8 +31,8 @@ struct PairExecution {
 };
 
 struct RegisteredPairs {
-  std::map<PairIndex, FinishedPair> finished;  // every finished pair the plan uses or probed
-  std::vector<PairIndex> chain;                // the chain the poses are built from
+  std::map<PairIndex, PairResult> finished;  // every finished pair the plan uses or probed
+  std::vector<PairIndex> chain;              // the chain the poses are built from
 };
 
 /// Loads the store's finished pairs, then registers the rest of `plan` with

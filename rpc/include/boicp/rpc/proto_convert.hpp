@@ -6,6 +6,7 @@
 #include <string>
 
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/util/types.hpp"
 #include "boicp/v1/map_builder.pb.h"
@@ -41,6 +42,11 @@ v1::ScanMetadata ScanMetadataOf(const ScanSource& scan);
 /// arrives: format and depth camera, sensor origin, prior pose, and the
 /// optional sha256 (64 lowercase hex digits). Throws InputError naming the field.
 void ValidateScanMetadata(const v1::ScanMetadata& metadata);
+
+/// A batch's pairing as asked (MODE_UNSPECIFIED is consecutive, MODE_KEYFRAMES
+/// overlap). Throws InputError for a mode this daemon does not know.
+PairingRequest PairingFromProto(const v1::PairingPolicy& proto);
+v1::PairingPolicy PairingToProto(const PairingRequest& pairing);
 
 /// The rung whose answer a pair kept (RungName's word). Results stored
 /// before it was recorded carry none: every answer then was a full search.
