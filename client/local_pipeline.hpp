@@ -14,6 +14,7 @@
 
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/settings/requested_settings.hpp"
 #include "local_pairs.hpp"

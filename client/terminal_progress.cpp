@@ -56,13 +56,13 @@ void TerminalProgress::PairFinished(const PairResult& pair, bool reused, const P
   pairs_.Done(pair, reused);
 }
 
-void TerminalProgress::StageStarted(const std::string& /*stage*/, int /*total*/) {
+void TerminalProgress::StageStarted(MapStage /*stage*/, int /*total*/) {
   if (reported_) FinishPairs();  // `boicp merge` registers nothing and says so elsewhere
   terminal_ = StderrIsTerminal();
 }
 
 void TerminalProgress::AssemblyStep(const AssemblyProgress& p) {
-  if (p.stage != "fusing") return;
+  if (p.stage != MapStage::kFusing) return;
   if (terminal_) {
     std::fprintf(stderr, "\rfusing %d/%d scans", p.done, p.total);
     if (p.done == p.total) std::fputc('\n', stderr);

@@ -30,7 +30,7 @@ class TerminalProgress : public MapProgressSink {
   TerminalProgress() : pairs_(0) {}
 
   void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override;
-  void StageStarted(const std::string& stage, int total) override;
+  void StageStarted(MapStage stage, int total) override;
   void AssemblyStep(const AssemblyProgress& progress) override;
 
   /// Prints the registration summary line, once.

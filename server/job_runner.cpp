@@ -59,8 +59,11 @@ class JobRun : public MapProgressSink {
       execution.stop_requested = [this] { return control_.StopRequested(); };
       // Returns only once none of the job's pair tasks runs: no pair is
       // stored after the job's final state, whatever was thrown.
-      const MapPipelineResult result = RunMapPipeline(
-          batch_, pairs, *this, execution, JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id())));
+      MapPipelineHooks hooks;
+      hooks.before_fusion = [this] { PrepareFusion(); };
+      const MapPipelineResult result =
+          RunMapPipeline(batch_, pairs, *this, execution,
+                         JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id())), hooks);
       pairs_ = nullptr;
       return Finish(result);
     } catch (const Cancelled&) {
@@ -111,7 +114,7 @@ class JobRun : public MapProgressSink {
       control_.SetDeadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                               std::chrono::duration<double>(std::max(left, 0.0))));
     }
-    job_.set_stage("registering");
+    job_.set_stage(MapStageName(MapStage::kRegistering));
     job_.set_eta_seconds(-1.0);
   }
 
@@ -178,24 +181,25 @@ class JobRun : public MapProgressSink {
     }
   }
 
-  void StageStarted(const std::string& stage, int total) override {
-    if (stage == "fusing") {
-      const std::string dir = ctx_.data_dir.CreateJobDir(job_.job_id());
-      RemoveStagingFiles(dir);
-    }
-    SetStage(stage, 0, static_cast<uint32_t>(total));
-    if (stage == "fusing") {
-      VerifyScans();  // fusion reads every scan again; the registrations took a while
-      fuse_start_ = Clock::now();
-    }
+  void StageStarted(MapStage stage, int total) override {
+    SetStage(MapStageName(stage), 0, static_cast<uint32_t>(total));
+  }
+
+  // The pipeline's hook before fusion (MapPipelineHooks).
+  void PrepareFusion() {
+    const std::string dir = ctx_.data_dir.CreateJobDir(job_.job_id());
+    RemoveStagingFiles(dir);
+    VerifyScans();  // fusion reads every scan again; the registrations took a while
+    fuse_start_ = Clock::now();
   }
 
   void AssemblyStep(const AssemblyProgress& p) override {
-    const bool new_stage = p.stage != job_.stage();
-    if (new_stage) job_.set_stage(p.stage);
+    const std::string stage = MapStageName(p.stage);
+    const bool new_stage = stage != job_.stage();
+    if (new_stage) job_.set_stage(stage);
     job_.set_stage_done(static_cast<uint32_t>(p.done));
     job_.set_stage_total(static_cast<uint32_t>(p.total));
-    if (p.stage == "fusing" && p.done > 0) {
+    if (p.stage == MapStage::kFusing && p.done > 0) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - fuse_start_).count();
       job_.set_eta_seconds(elapsed / p.done * (p.total - p.done));
     }
@@ -218,7 +222,7 @@ class JobRun : public MapProgressSink {
   // Pairs finish at the rate seen so far in this run; the ETA counts down
   // between completions.
   void UpdateEta() {
-    if (done_this_run_ == 0 || job_.stage() != "registering") return;
+    if (done_this_run_ == 0 || job_.stage() != MapStageName(MapStage::kRegistering)) return;
     const double per_pair =
         std::chrono::duration<double>(last_done_ - run_start_).count() / done_this_run_;
     const double remaining =

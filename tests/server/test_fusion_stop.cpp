@@ -49,7 +49,7 @@ class FusionStop : public ::testing::Test {
     int fused = 0;
     const auto report = callbacks.progress;
     callbacks.progress = [&](const AssemblyProgress& p) {
-      if (p.stage == "fusing") fused = p.done;
+      if (p.stage == MapStage::kFusing) fused = p.done;
       if (report) report(p);
     };
     EXPECT_THROW(FuseScans(scans_, poses_, settings_, outputs_, callbacks), Cancelled);
@@ -88,7 +88,7 @@ TEST_F(FusionStop, StopDuringWritingLeavesNoTree) {
   std::atomic<bool> writing{false};
   AssemblyCallbacks callbacks;
   callbacks.progress = [&writing](const AssemblyProgress& p) {
-    if (p.stage == "writing") writing = true;
+    if (p.stage == MapStage::kWriting) writing = true;
   };
   callbacks.stop_requested = [&writing] { return writing.load(); };
   // Only the polls from inside the .ot write can see it: the between-output

@@ -13,7 +13,7 @@
 namespace boicp {
 namespace {
 
-void Report(const AssemblyCallbacks& callbacks, const std::string& stage, int done, int total) {
+void Report(const AssemblyCallbacks& callbacks, MapStage stage, int done, int total) {
   if (callbacks.progress) callbacks.progress({stage, done, total});
 }
 
@@ -173,7 +173,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
         }
       });
       for (size_t k = 1; k <= current.size(); ++k) {
-        Report(callbacks, "fusing", first + static_cast<int>(k), total);
+        Report(callbacks, MapStage::kFusing, first + static_cast<int>(k), total);
       }
       current = std::move(next);
     }
@@ -182,7 +182,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
   }
 
   ThrowIfStopped(callbacks);
-  Report(callbacks, "writing", 0, 1);
+  Report(callbacks, MapStage::kWriting, 0, 1);
   FusionSummary summary;
   summary.points_out_of_range = points_out_of_range;
   summary.occupied_leaves = map.OccupiedLeaves();
@@ -217,7 +217,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
     WriteFileAtomically(outputs.cloud_ply,
                         [&](const std::string& tmp) { WritePlyPoints(tmp, merged); });
   }
-  Report(callbacks, "writing", 1, 1);
+  Report(callbacks, MapStage::kWriting, 1, 1);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -43,10 +43,11 @@ std::vector<PairIndex> PairsInGraph(const GraphEdges& edges, const PoseEstimate&
 
 AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registered, PairStore& store,
                          MapProgressSink& progress, const MapOutputPaths& outputs,
-                         const std::function<bool()>& stop_requested) {
+                         const std::function<bool()>& stop_requested,
+                         const MapPipelineHooks& hooks) {
   const GraphEdges edges = GraphConstraints(batch.plan, registered);
   const bool loops = edges.constraints.size() + 1 > batch.scans.size();
-  progress.StageStarted(loops ? "optimising" : "chaining", 1);
+  progress.StageStarted(loops ? MapStage::kOptimising : MapStage::kChaining, 1);
   AssembledMap assembled;
   assembled.estimate =
       EstimatePoses(batch.scans, edges.constraints, BatchPoseGraphOptions(batch.config));
@@ -54,7 +55,8 @@ AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registere
   store.MarkInGraph(assembled.in_graph);
   progress.PosesEstimated(assembled.estimate, assembled.in_graph);
 
-  progress.StageStarted("fusing", static_cast<int>(batch.scans.size()));
+  progress.StageStarted(MapStage::kFusing, static_cast<int>(batch.scans.size()));
+  if (hooks.before_fusion) hooks.before_fusion();
   AssemblyCallbacks callbacks;
   callbacks.stop_requested = stop_requested;
   callbacks.progress = [&progress](const AssemblyProgress& p) { progress.AssemblyStep(p); };
@@ -64,11 +66,13 @@ AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registere
 }
 
 MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapProgressSink& progress,
-                                 const PairExecution& execution, const MapOutputPaths& outputs) {
+                                 const PairExecution& execution, const MapOutputPaths& outputs,
+                                 const MapPipelineHooks& hooks) {
   MapPipelineResult result;
   result.pairs =
       RegisterPlannedPairs(batch.scans, batch.config, batch.plan, store, progress, execution);
-  result.map = AssembleMap(batch, result.pairs, store, progress, outputs, execution.stop_requested);
+  result.map =
+      AssembleMap(batch, result.pairs, store, progress, outputs, execution.stop_requested, hooks);
   return result;
 }
 

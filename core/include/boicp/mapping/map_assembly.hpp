@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/mapping/map_stage.hpp"
 #include "boicp/mapping/occupancy_map.hpp"
 #include "boicp/mapping/pose_graph.hpp"
 
@@ -70,7 +71,7 @@ struct MapOutputPaths {
 };
 
 struct AssemblyProgress {
-  std::string stage;  // "fusing" or "writing"
+  MapStage stage = MapStage::kFusing;  // kFusing or kWriting
   int done = 0;
   int total = 0;
 };

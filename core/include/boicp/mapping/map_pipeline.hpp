@@ -42,14 +42,25 @@ struct AssembledMap {
   FusionSummary fusion;
 };
 
+/// Work a front end does at fixed points of the pipeline, apart from what
+/// it reports. Empty: nothing.
+struct MapPipelineHooks {
+  /// Once the poses are known and kFusing is reported, before fusion reads
+  /// the scans again and writes the outputs (the daemon creates the job's
+  /// folder, clears its staging files and re-hashes every scan).
+  std::function<void()> before_fusion;
+};
+
 /// Poses from the registered pairs, then fusion into `outputs`. Reports the
-/// stages to `progress`, marks the used pairs in `store`. Throws InputError
+/// stages to `progress`, marks the used pairs in `store`, runs `hooks` at
+/// their points. Throws InputError
 /// when the pairs leave a scan unreached or a scan no longer loads,
 /// Cancelled when `stop_requested` fires during fusion, std::runtime_error
 /// when an output cannot be written.
 AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registered, PairStore& store,
                          MapProgressSink& progress, const MapOutputPaths& outputs,
-                         const std::function<bool()>& stop_requested = {});
+                         const std::function<bool()>& stop_requested = {},
+                         const MapPipelineHooks& hooks = {});
 
 struct MapPipelineResult {
   RegisteredPairs pairs;
@@ -59,6 +70,7 @@ struct MapPipelineResult {
 /// The whole pipeline: RegisterPlannedPairs, then AssembleMap (with the
 /// execution's stop_requested). Throws what either throws.
 MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapProgressSink& progress,
-                                 const PairExecution& execution, const MapOutputPaths& outputs);
+                                 const PairExecution& execution, const MapOutputPaths& outputs,
+                                 const MapPipelineHooks& hooks = {});
 
 }  // namespace boicp

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/map_stage.hpp"
 #include "boicp/mapping/pair_result.hpp"
 
 namespace boicp {
@@ -36,15 +37,15 @@ class MapProgressSink {
   /// Called several times a second while pairs run (to refresh an ETA).
   virtual void Heartbeat() {}
 
-  /// An assembly stage begins: "chaining" or "optimising" (one step), then
-  /// "fusing" (`total` scans).
-  virtual void StageStarted(const std::string& /*stage*/, int /*total*/) {}
+  /// An assembly stage begins: kChaining or kOptimising (one step), then
+  /// kFusing (`total` scans).
+  virtual void StageStarted(MapStage /*stage*/, int /*total*/) {}
 
   /// The poses are estimated; `in_graph` are the pairs they use. Fusion follows.
   virtual void PosesEstimated(const PoseEstimate& /*estimate*/,
                               const std::vector<PairIndex>& /*in_graph*/) {}
 
-  /// FuseScans' own progress ("fusing" per scan, then "writing").
+  /// FuseScans' own progress (kFusing per scan, then kWriting).
   virtual void AssemblyStep(const AssemblyProgress& /*progress*/) {}
 };
 
