@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
-#include "boicp/mapping/map_assembly.hpp"
+#include "boicp/io/scan_source.hpp"
 
 namespace boicp {
 
