@@ -30,8 +30,8 @@ struct StoredScan {
 
 /// What a job needs to run, as accepted at submission.
 struct JobInput {
-  v1::SubmitBatchRequest request;
-  std::vector<v1::ScanMetadata> scans;  // one per request.scan_ids entry
+  v1::SubmitBatchRequest request;       // stored whole: its scan_context is the batch's
+  std::vector<v1::ScanMetadata> scans;  // one per request.scan_ids entry, the stored records
 };
 
 struct StoredPair {
@@ -63,7 +63,8 @@ class JobStore {
   explicit JobStore(const std::string& path);
 
   /// Stores a scan's record unless it has one, and returns the record as
-  /// stored. The first upload's metadata and point count stay for good (see
+  /// stored. The first upload's metadata (its context too, the default for
+  /// batches that send none) and point count stay for good (see
   /// scan_metadata_once.hpp); a later call only fills in the range profile of
   /// a record stored without one, when its metadata is the same.
   StoredScan PutScan(const v1::ScanMetadata& metadata, uint64_t num_points,

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <charconv>
-#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -21,14 +20,6 @@ std::string NumberText(double value) {
   return std::string(text, end.ptr);
 }
 
-std::string OptionalText(const std::optional<double>& value) {
-  return value ? NumberText(*value) : "none";
-}
-
-std::string PointText(const v1::Vector3& p) {
-  return NumberText(p.x()) + " " + NumberText(p.y()) + " " + NumberText(p.z());
-}
-
 std::string ValuesText(const std::vector<uint16_t>& values) {
   std::string text;
   for (uint16_t value : values) text += (text.empty() ? "" : " ") + std::to_string(value);
@@ -38,10 +29,6 @@ std::string ValuesText(const std::vector<uint16_t>& values) {
 void AddIfDifferent(std::vector<std::string>& differences, const std::string& field,
                     const std::string& stored, const std::string& sent) {
   if (stored != sent) differences.push_back(field + " (stored " + stored + ", sent " + sent + ")");
-}
-
-std::optional<double> Timestamp(const v1::ScanMetadata& metadata) {
-  return metadata.has_timestamp() ? std::optional<double>(metadata.timestamp()) : std::nullopt;
 }
 
 // The camera as the depth loader applies it; both sides were validated at
@@ -66,20 +53,6 @@ void AddDepthDifferences(std::vector<std::string>& differences, const v1::ScanMe
   AddIfDifferent(differences, "depth.invalid_values", ValuesText(invalid_a), ValuesText(invalid_b));
 }
 
-bool SamePose(const v1::Transform& a, const v1::Transform& b) {
-  return std::equal(a.m().begin(), a.m().end(), b.m().begin(), b.m().end());
-}
-
-void AddPriorPoseDifference(std::vector<std::string>& differences, const v1::ScanMetadata& stored,
-                            const v1::ScanMetadata& sent) {
-  if (stored.has_prior_pose() != sent.has_prior_pose()) {
-    differences.push_back(std::string("prior_pose (stored ") +
-                          (stored.has_prior_pose() ? "one, sent none)" : "none, sent one)"));
-  } else if (stored.has_prior_pose() && !SamePose(stored.prior_pose(), sent.prior_pose())) {
-    differences.push_back("prior_pose (stored and sent differ)");
-  }
-}
-
 }  // namespace
 
 std::vector<std::string> MetadataDifferences(const v1::ScanMetadata& stored,
@@ -90,11 +63,6 @@ std::vector<std::string> MetadataDifferences(const v1::ScanMetadata& stored,
   if (stored.format() == v1::SCAN_FORMAT_DEPTH_PNG && sent.format() == v1::SCAN_FORMAT_DEPTH_PNG) {
     AddDepthDifferences(differences, stored, sent);
   }
-  AddIfDifferent(differences, "sensor_origin", PointText(stored.sensor_origin()),
-                 PointText(sent.sensor_origin()));
-  AddPriorPoseDifference(differences, stored, sent);
-  AddIfDifferent(differences, "timestamp", OptionalText(Timestamp(stored)),
-                 OptionalText(Timestamp(sent)));
   return differences;
 }
 
@@ -115,7 +83,9 @@ void RequireStoredMetadata(const std::string& scan_id, const v1::ScanMetadata& s
           ". A scan's metadata is written once, by its first upload, so that no upload changes "
           "what batches naming the scan read: send the stored metadata to use the scan as "
           "stored. Other metadata is accepted once the daemon has let the scan go (no job uses "
-          "it, and nobody uploaded or found it for --scan-grace-hours)");
+          "it, and nobody uploaded or found it for --scan-grace-hours). The sensor origin, prior "
+          "pose and timestamp are not part of this: a batch sends its own "
+          "(SubmitBatchRequest.scan_context)");
 }
 
 }  // namespace boicp::server

@@ -178,8 +178,9 @@ bool UploadReactor::ReuseStoredCopy(const v1::ScanMetadata& metadata) {
   if (metadata.sha256().empty()) return false;
   const std::optional<StoredScan> stored = deps_.store.GetScan(metadata.sha256());
   if (!stored) return false;
-  // Refused before any work on the bytes: a copy whose metadata cannot change
-  // is not worth hashing for this client.
+  // Refused before any work on the bytes: a copy this client would decode
+  // otherwise is not worth hashing for it. Another context (sensor origin,
+  // prior pose, timestamp) is a reuse: the stored record stays as it is.
   RequireStoredMetadata(metadata.sha256(), stored->metadata, metadata);
   if (!deps_.data_dir.HasScanFile(metadata.sha256())) return false;
   RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight());
@@ -234,7 +235,7 @@ void UploadReactor::Complete() {
   if (!metadata.sha256().empty() && metadata.sha256() != id) {
     throw InputError("metadata.sha256 does not match the bytes received (got " + id + ")");
   }
-  // Bytes sent with other metadata than the stored record's are refused
+  // Bytes sent with another decoding than the stored record's are refused
   // before they are parsed, as a metadata-only upload would be.
   if (const std::optional<StoredScan> stored = deps_.store.GetScan(id)) {
     RequireStoredMetadata(id, stored->metadata, metadata);
@@ -249,7 +250,8 @@ void UploadReactor::Complete() {
   }
   metadata.set_sha256(id);
   // Another upload of these bytes may have stored its record since the
-  // check above: the first record stays, and this one must agree with it.
+  // check above: the first record (and its context) stays, and this one must
+  // decode the bytes as it does.
   const StoredScan kept =
       deps_.store.PutScan(metadata, cloud.points.size(), ProfileRanges(cloud.points));
   RequireStoredMetadata(id, kept.metadata, metadata);
