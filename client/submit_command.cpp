@@ -100,6 +100,11 @@ int RunSubmit(SubmitFlags& f) {
   for (const std::string& id : UploadScans(*daemon.client, folder, metadata)) {
     request.add_scan_ids(id);
   }
+  // Every scan's context (sensor origin, prior pose, timestamp) goes with the
+  // batch: the daemon keeps a scan's first upload's as a default only, so a
+  // second submit of the same scans with other priors or times uses its own.
+  for (const ScanSource& scan : folder.scans)
+    *request.add_scan_context() = rpc::ScanContextOf(scan);
   const v1::Job job = daemon.client->Submit(request);
   std::printf("%s\n", job.job_id().c_str());
   std::fflush(stdout);

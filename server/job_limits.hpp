@@ -4,7 +4,10 @@
 // search's samples and steps, points per evaluation, search ranges, leaf
 // and merged-cloud voxel sizes) are the settings schema's RequestLimits;
 // here are those that span fields or are not settings: the map's cells per
-// ray, the listed pairs, the label.
+// ray, the listed pairs, the label. The scan ids are bounded by
+// --max-batch-scans (JobManager::Submit); scan_context must have one entry
+// per scan id or none (BuildJobSpec), and the whole request, context
+// included, is bounded by --max-message-bytes before it is parsed.
 
 #include <cstddef>
 

@@ -10,6 +10,38 @@
 #include "job_limits.hpp"
 
 namespace boicp::server {
+namespace {
+
+// Where a scan was taken, from a message that says it (ScanMetadata or
+// ScanContext, whose fields share their names); unset fields mean none.
+template <typename Context>
+void ApplyContextFields(const Context& context, const std::string& field, ScanSource& source) {
+  if (context.has_sensor_origin()) {
+    source.sensor_origin = rpc::PointFromProto(context.sensor_origin(), field + ".sensor_origin");
+  }
+  if (context.has_prior_pose()) {
+    source.prior_pose = rpc::TransformFromProto(context.prior_pose(), field + ".prior_pose");
+  }
+  if (context.has_timestamp()) {
+    if (!std::isfinite(context.timestamp())) {
+      throw InputError(field + ".timestamp: non-finite value");
+    }
+    source.timestamp = context.timestamp();
+  }
+}
+
+// The scan's context in the batch: the request's scan_context[i] when the
+// batch sends one, else the context its first upload stored.
+void ApplyScanContext(const v1::SubmitBatchRequest& request, int i, const v1::ScanMetadata& meta,
+                      ScanSource& source) {
+  if (request.scan_context_size() == 0) {
+    ApplyContextFields(meta, "scan_ids[" + std::to_string(i) + "]", source);
+  } else {
+    ApplyContextFields(request.scan_context(i), "scan_context[" + std::to_string(i) + "]", source);
+  }
+}
+
+}  // namespace
 
 BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads) {
   try {
@@ -39,21 +71,22 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
   if (static_cast<int>(scans.size()) != n) {
     throw std::runtime_error("job " + job_id + ": scan metadata does not match the batch");
   }
+  // One context per scan or none: the count is bounded by scan_ids'
+  // (--max-batch-scans) and the request by --max-message-bytes.
+  if (request.scan_context_size() != 0 && request.scan_context_size() != n) {
+    throw InputError("scan_context: " + std::to_string(request.scan_context_size()) +
+                     " entries for " + std::to_string(n) +
+                     " scan_ids; send one per scan, in the same order, or none (each scan's "
+                     "context as its first upload stored it)");
+  }
   for (int i = 0; i < n; ++i) {
     const v1::ScanMetadata& meta = scans[static_cast<size_t>(i)];
-    const std::string field = "scan_ids[" + std::to_string(i) + "]";
     ScanSource source;
     source.path = data_dir.ScanPath(request.scan_ids(i));
     source.load = rpc::LoadOptionsFromMetadata(meta);
     // Stored scans met the point limit at upload; the job checks it at submission.
     source.load.max_points = std::numeric_limits<uint64_t>::max();
-    if (meta.has_sensor_origin()) {
-      source.sensor_origin = rpc::PointFromProto(meta.sensor_origin(), field + ".sensor_origin");
-    }
-    if (meta.has_prior_pose()) {
-      source.prior_pose = rpc::TransformFromProto(meta.prior_pose(), field + ".prior_pose");
-    }
-    if (meta.has_timestamp()) source.timestamp = meta.timestamp();
+    ApplyScanContext(request, i, meta, source);
     spec.scan_ids.push_back(request.scan_ids(i));
     spec.scans.push_back(std::move(source));
   }

@@ -1,8 +1,9 @@
 #pragma once
-// A job as the runner needs it, built from the stored request and the
-// snapshot of its scans' metadata. The same function validates a batch at
-// submission and rebuilds it when a restarted daemon resumes the job, so
-// both see the same configuration.
+// A job as the runner needs it, built from the stored request (with the
+// batch's scan context, if it sent one) and the snapshot of its scans'
+// metadata. The same function validates a batch at submission and rebuilds
+// it when a restarted daemon resumes the job, so both see the same
+// configuration.
 
 #include <string>
 #include <vector>
@@ -44,7 +45,11 @@ v1::ChosenSettings ChosenSettingsToProto(const BoIcpConfig& config, const MapBui
                                          const BatchSettingsChoice& choice);
 
 /// Validates everything about a batch except that its scans exist (the
-/// caller looked them up to get `scans`). Throws InputError naming the field.
+/// caller looked them up to get `scans`, the job's snapshot of their stored
+/// records). Each scan decodes as its record says; its context (sensor
+/// origin, prior pose, timestamp) is the request's scan_context entry when
+/// the batch sends them, else the record's. Throws InputError naming the
+/// field (e.g. "scan_context[3].prior_pose").
 JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& request,
                      const std::vector<v1::ScanMetadata>& scans, const DataDir& data_dir,
                      int registration_threads);

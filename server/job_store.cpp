@@ -182,22 +182,30 @@ int JobStore::ReadUnendedRuns(const std::string& job_id) {
   return stmt.Step() ? static_cast<int>(stmt.ColumnInt(0)) : 0;
 }
 
-void JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points,
-                       const RangeProfile& ranges) {
+StoredScan JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points,
+                             const RangeProfile& ranges) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // An existing record is kept: of two first uploads racing, the second
+  // finds the first's record and is answered with it.
   db_.Prepare(
          "INSERT INTO scans (scan_id, num_points, metadata, range_profile) "
          "VALUES (?1, ?2, ?3, ?4) "
-         "ON CONFLICT (scan_id) DO UPDATE SET num_points = ?2, metadata = ?3, range_profile = ?4")
+         "ON CONFLICT (scan_id) DO UPDATE SET range_profile = ?4 "
+         "WHERE length(scans.range_profile) = 0 AND scans.metadata = ?3")
       .Bind(1, metadata.sha256())
       .Bind(2, static_cast<int64_t>(num_points))
       .BindBlob(3, Serialize(metadata))
       .BindBlob(4, RangeProfileBytes(ranges))
       .Run();
+  return *ReadScan(metadata.sha256());
 }
 
 std::optional<StoredScan> JobStore::GetScan(const std::string& scan_id) {
   std::lock_guard<std::mutex> lock(mutex_);
+  return ReadScan(scan_id);
+}
+
+std::optional<StoredScan> JobStore::ReadScan(const std::string& scan_id) {
   auto stmt =
       db_.Prepare("SELECT num_points, metadata, range_profile FROM scans WHERE scan_id = ?1");
   stmt.Bind(1, scan_id);

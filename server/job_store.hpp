@@ -30,8 +30,8 @@ struct StoredScan {
 
 /// What a job needs to run, as accepted at submission.
 struct JobInput {
-  v1::SubmitBatchRequest request;
-  std::vector<v1::ScanMetadata> scans;  // one per request.scan_ids entry
+  v1::SubmitBatchRequest request;       // stored whole: its scan_context is the batch's
+  std::vector<v1::ScanMetadata> scans;  // one per request.scan_ids entry, the stored records
 };
 
 struct StoredPair {
@@ -62,7 +62,13 @@ class JobStore {
   /// schema version newer than kSchemaVersion.
   explicit JobStore(const std::string& path);
 
-  void PutScan(const v1::ScanMetadata& metadata, uint64_t num_points, const RangeProfile& ranges);
+  /// Stores a scan's record unless it has one, and returns the record as
+  /// stored. The first upload's metadata (its context too, the default for
+  /// batches that send none) and point count stay for good (see
+  /// scan_metadata_once.hpp); a later call only fills in the range profile of
+  /// a record stored without one, when its metadata is the same.
+  StoredScan PutScan(const v1::ScanMetadata& metadata, uint64_t num_points,
+                     const RangeProfile& ranges);
   std::optional<StoredScan> GetScan(const std::string& scan_id);
 
   /// Assigns the job id ("job-000001", ...) and stores the job and its
@@ -130,6 +136,8 @@ class JobStore {
   void AddMissingColumn(const std::string& table, const std::string& column,
                         const std::string& definition);
   int ReadUnendedRuns(const std::string& job_id);
+  /// GetScan with mutex_ already held.
+  std::optional<StoredScan> ReadScan(const std::string& scan_id);
   std::optional<v1::Job> ReadJob(const std::string& job_id);
   void WriteJob(const v1::Job& job);
 

@@ -10,6 +10,7 @@
 #include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "scan_integrity.hpp"
+#include "scan_metadata_once.hpp"
 #include "service.hpp"
 #include "service_error.hpp"
 #include "storage_check.hpp"
@@ -59,12 +60,6 @@ LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& me
                        "the upload stopped waiting for decoding memory (--max-decode-mb): "
                        "it was cancelled or boicpd is shutting down");
   }
-}
-
-// The stored points stay valid when the new metadata reads the bytes the
-// same way (same format and camera).
-bool SameDecoding(const v1::ScanMetadata& a, const v1::ScanMetadata& b) {
-  return a.format() == b.format() && a.depth().SerializeAsString() == b.depth().SerializeAsString();
 }
 
 }  // namespace
@@ -182,7 +177,12 @@ void UploadReactor::AcceptMetadata(const v1::ScanMetadata& metadata) {
 bool UploadReactor::ReuseStoredCopy(const v1::ScanMetadata& metadata) {
   if (metadata.sha256().empty()) return false;
   const std::optional<StoredScan> stored = deps_.store.GetScan(metadata.sha256());
-  if (!stored || !deps_.data_dir.HasScanFile(metadata.sha256())) return false;
+  if (!stored) return false;
+  // Refused before any work on the bytes: a copy this client would decode
+  // otherwise is not worth hashing for it. Another context (sensor origin,
+  // prior pose, timestamp) is a reuse: the stored record stays as it is.
+  RequireStoredMetadata(metadata.sha256(), stored->metadata, metadata);
+  if (!deps_.data_dir.HasScanFile(metadata.sha256())) return false;
   RequireStorage(deps_.data_dir, deps_.min_free_bytes, deps_.uploads.bytes_in_flight());
   deps_.data_dir.TouchScan(metadata.sha256());
   ticket_.emplace(deps_.uploads, stored->metadata.size_bytes());
@@ -215,30 +215,11 @@ void UploadReactor::AcceptChunk(const std::string& bytes) {
 
 void UploadReactor::Complete() {
   if (!metadata_) throw InputError("empty upload: send metadata, then the bytes");
-  v1::ScanMetadata metadata = *metadata_;
   if (known_) {
-    // The new metadata must still describe the stored bytes: a format or
-    // camera change re-parses them (as does a scan stored without a range
-    // profile); the same decoding keeps the stored count and profile.
-    const StoredScan stored = *deps_.store.GetScan(metadata.sha256());
-    uint64_t points = stored.num_points;
-    RangeProfile ranges = stored.ranges;
-    if (!SameDecoding(metadata, stored.metadata) || ranges.empty()) {
-      const LoadedCloud cloud =
-          LoadUploadedScan(deps_.data_dir.ScanPath(metadata.sha256()), metadata, deps_, context_);
-      points = cloud.points.size();
-      ranges = ProfileRanges(cloud.points);
-    }
-    RequirePointLimit(points, deps_.max_scan_points);
-    metadata.set_size_bytes(stored.metadata.size_bytes());
-    deps_.store.PutScan(metadata, points, ranges);
-    response_->set_scan_id(metadata.sha256());
-    response_->set_already_present(true);
-    response_->set_num_points(points);
-    response_->set_size_bytes(metadata.size_bytes());
-    spdlog::info("scan {} already stored; metadata updated", metadata.sha256().substr(0, 12));
+    AnswerFromStoredCopy();
     return;
   }
+  v1::ScanMetadata metadata = *metadata_;
   if (received_ == 0 && !corruption_.empty()) {
     throw ServiceError(grpc::StatusCode::DATA_LOSS, corruption_ + "; send the bytes with it");
   }
@@ -254,6 +235,11 @@ void UploadReactor::Complete() {
   if (!metadata.sha256().empty() && metadata.sha256() != id) {
     throw InputError("metadata.sha256 does not match the bytes received (got " + id + ")");
   }
+  // Bytes sent with another decoding than the stored record's are refused
+  // before they are parsed, as a metadata-only upload would be.
+  if (const std::optional<StoredScan> stored = deps_.store.GetScan(id)) {
+    RequireStoredMetadata(id, stored->metadata, metadata);
+  }
   const LoadedCloud cloud = LoadUploadedScan(temp_path_, metadata, deps_, context_);
   const bool present = deps_.data_dir.HasScanFile(id);
   if (!present) {
@@ -263,13 +249,41 @@ void UploadReactor::Complete() {
     deps_.data_dir.TouchScan(id);  // uploaded again: its grace starts again
   }
   metadata.set_sha256(id);
-  deps_.store.PutScan(metadata, cloud.points.size(), ProfileRanges(cloud.points));
+  // Another upload of these bytes may have stored its record since the
+  // check above: the first record (and its context) stays, and this one must
+  // decode the bytes as it does.
+  const StoredScan kept =
+      deps_.store.PutScan(metadata, cloud.points.size(), ProfileRanges(cloud.points));
+  RequireStoredMetadata(id, kept.metadata, metadata);
   response_->set_scan_id(id);
   response_->set_already_present(present);
-  response_->set_num_points(cloud.points.size());
+  response_->set_num_points(kept.num_points);
   response_->set_size_bytes(metadata.size_bytes());
   spdlog::info("scan {} stored: {} bytes, {} points", id.substr(0, 12), metadata.size_bytes(),
-               cloud.points.size());
+               kept.num_points);
+}
+
+void UploadReactor::AnswerFromStoredCopy() {
+  const std::string& id = metadata_->sha256();
+  const std::optional<StoredScan> stored = deps_.store.GetScan(id);
+  if (!stored) {
+    throw ServiceError(grpc::StatusCode::FAILED_PRECONDITION,
+                       "scan " + id + " was deleted, unused, meanwhile (upload it again)");
+  }
+  uint64_t points = stored->num_points;
+  if (stored->ranges.empty()) {
+    // Stored before range profiles were: profiled now, read as stored.
+    const LoadedCloud cloud =
+        LoadUploadedScan(deps_.data_dir.ScanPath(id), stored->metadata, deps_, context_);
+    points = deps_.store.PutScan(stored->metadata, cloud.points.size(), ProfileRanges(cloud.points))
+                 .num_points;
+  }
+  RequirePointLimit(points, deps_.max_scan_points);
+  response_->set_scan_id(id);
+  response_->set_already_present(true);
+  response_->set_num_points(points);
+  response_->set_size_bytes(stored->metadata.size_bytes());
+  spdlog::info("scan {} already stored; reused with its stored metadata", id.substr(0, 12));
 }
 
 }  // namespace boicp::server

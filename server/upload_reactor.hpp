@@ -2,12 +2,15 @@
 // UploadScan: metadata first, then the bytes in chunks, written to a temp
 // file and hashed as they arrive. At the end the scan is parsed with the
 // core loaders (so a malformed scan is refused at upload, not mid-batch),
-// then renamed to its hash and recorded. Refused (FAILED_PRECONDITION) while
-// the data directory cannot take the announced bytes with those of the other
-// uploads in flight, and (RESOURCE_EXHAUSTED) over the upload budget, which
-// an upload reusing stored bytes is charged their size in too. An upload
-// that goes silent or sends slower than the minimum rate ends (see
-// UploadWatchdog), so a slot is never held for long by a slow client.
+// then renamed to its hash and recorded. A scan's metadata is written once:
+// stored bytes sent or named again with metadata a batch would read
+// differently are refused (FAILED_PRECONDITION, scan_metadata_once.hpp).
+// Refused (FAILED_PRECONDITION) while the data directory cannot take the
+// announced bytes with those of the other uploads in flight, and
+// (RESOURCE_EXHAUSTED) over the upload budget, which an upload reusing
+// stored bytes is charged their size in too. An upload that goes silent or
+// sends slower than the minimum rate ends (see UploadWatchdog), so a slot is
+// never held for long by a slow client.
 
 #include <fstream>
 #include <optional>
@@ -40,6 +43,9 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   void AcceptMetadata(const ::boicp::v1::ScanMetadata& metadata);
   void AcceptChunk(const std::string& bytes);
   void Complete();
+  /// Answers an upload naming a stored hash with the stored record: its
+  /// metadata, checked in ReuseStoredCopy, is what the client sent.
+  void AnswerFromStoredCopy();
   /// Frees the upload's slot and bytes in the budget, then finishes: a client
   /// that has heard this upload end is never refused because of it.
   void FinishUpload(const grpc::Status& status);

@@ -137,10 +137,19 @@ v1::ScanMetadata ScanMetadataOf(const ScanSource& scan) {
     camera.set_depth_scale(depth.depth_scale);
     for (uint16_t value : depth.invalid_values) camera.add_invalid_values(value);
   }
-  *metadata.mutable_sensor_origin() = PointToProto(scan.sensor_origin);
-  if (scan.prior_pose) TransformToProto(*scan.prior_pose, metadata.mutable_prior_pose());
-  if (scan.timestamp) metadata.set_timestamp(*scan.timestamp);
+  const v1::ScanContext context = ScanContextOf(scan);
+  *metadata.mutable_sensor_origin() = context.sensor_origin();
+  if (context.has_prior_pose()) *metadata.mutable_prior_pose() = context.prior_pose();
+  if (context.has_timestamp()) metadata.set_timestamp(context.timestamp());
   return metadata;
+}
+
+v1::ScanContext ScanContextOf(const ScanSource& scan) {
+  v1::ScanContext context;
+  *context.mutable_sensor_origin() = PointToProto(scan.sensor_origin);
+  if (scan.prior_pose) TransformToProto(*scan.prior_pose, context.mutable_prior_pose());
+  if (scan.timestamp) context.set_timestamp(*scan.timestamp);
+  return context;
 }
 
 void ValidateScanMetadata(const v1::ScanMetadata& metadata) {

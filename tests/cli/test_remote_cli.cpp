@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -283,6 +284,53 @@ TEST_F(RemoteCli, TheIcpMethodReachesTheDaemonsJob) {
     for (int row = 0; row < 3; ++row) {
       EXPECT_NEAR(pair["transform"][row][3].get<double>(), expected(row, 3), 0.1);
     }
+  }
+}
+
+// The same folder submitted again with --poses-as-priors and a times.txt:
+// the daemon holds the scans from the first submit (their first upload's
+// context is only its default), and each job uses the context it sent.
+TEST_F(RemoteCli, TheSameFolderSubmittedAgainWithPosesAsPriorsUsesThem) {
+  StartDaemon();
+  const fs::path root = dir_ / "drive";
+  const std::vector<boicp::Transform> truth = WriteDrive(root, 4, 11);
+  const std::string plain = SubmitAndWait(root.string() + kQuick + " --resolution 0.3");
+
+  // KITTI side files: poses 100 m along x from the drive's (Tr = identity,
+  // so the velodyne poses are the camera poses), and times.
+  std::ofstream(root / "calib.txt") << "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  {
+    std::ofstream poses(root / "poses.txt"), times(root / "times.txt");
+    poses << std::setprecision(17);
+    for (size_t i = 0; i < truth.size(); ++i) {
+      boicp::Transform T = truth[i];
+      T(0, 3) += 100.0;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) poses << T(r, c) << (r == 2 && c == 3 ? "\n" : " ");
+      }
+      times << 50 + static_cast<int>(i) << "\n";
+    }
+  }
+  const RunResult again = Run("submit " + root.string() + kQuick +
+                              " --resolution 0.3 --poses-as-priors --wait" + server_);
+  ASSERT_EQ(again.exit_code, 0) << again.err << "\n" << daemon_->Log();
+  EXPECT_THAT(again.err, HasSubstr("4 already on the daemon"));
+  ASSERT_EQ(Lines(again.out).size(), 1u) << again.out;
+  const std::string with_priors = Lines(again.out)[0];
+
+  for (const std::string& job : {plain, with_priors}) {
+    const RunResult show = Run("show " + job + " --json" + server_);
+    ASSERT_EQ(show.exit_code, 0) << show.err;
+    const nlohmann::json j = nlohmann::json::parse(show.out);
+    ASSERT_EQ(j["trajectory"].size(), 4u) << job;
+    const bool priors = job == with_priors;
+    for (size_t i = 0; i < 4; ++i) {
+      EXPECT_EQ(j["trajectory"][i]["timestamp"].get<double>(), (priors ? 50.0 : 0.0) + i) << job;
+    }
+    // The map frame is scan 0's, or its prior pose's world.
+    EXPECT_NEAR(j["trajectory"][0]["pose"][0][3].get<double>(),
+                priors ? truth[0](0, 3) + 100.0 : 0.0, 1e-6)
+        << job;
   }
 }
 

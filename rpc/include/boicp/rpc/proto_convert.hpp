@@ -38,6 +38,10 @@ LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata);
 /// InputError naming the file when a depth image lacks intrinsics or scale.
 v1::ScanMetadata ScanMetadataOf(const ScanSource& scan);
 
+/// A scan's context for SubmitBatchRequest.scan_context: the sensor origin,
+/// prior pose and timestamp ScanMetadataOf sends, from the same fields.
+v1::ScanContext ScanContextOf(const ScanSource& scan);
+
 /// Every check UploadScan makes on its metadata message before any byte
 /// arrives: format and depth camera, sensor origin, prior pose, and the
 /// optional sha256 (64 lowercase hex digits). Throws InputError naming the field.
