@@ -23,10 +23,9 @@ PairResult MakePairResult(const PairIndex& pair, const RegistrationResult& regis
   return out;
 }
 
-double PlannerOverlap(const PairResult& result) { return result.overlap.value_or(result.fitness); }
-
 KeyframePlanner::ProbeOutcome ProbeOutcomeOf(const PairResult& result) {
-  return {PlannerOverlap(result), result.search_reach.value_or(0.0), result.doubtful};
+  return {result.overlap.value_or(result.fitness), result.search_reach.value_or(0.0),
+          result.doubtful};
 }
 
 PairConstraint ConstraintOf(const PairResult& result) {

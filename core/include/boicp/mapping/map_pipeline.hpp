@@ -53,10 +53,9 @@ struct MapPipelineHooks {
 
 /// Poses from the registered pairs, then fusion into `outputs`. Reports the
 /// stages to `progress`, marks the used pairs in `store`, runs `hooks` at
-/// their points. Throws InputError
-/// when the pairs leave a scan unreached or a scan no longer loads,
-/// Cancelled when `stop_requested` fires during fusion, std::runtime_error
-/// when an output cannot be written.
+/// their points. Throws InputError when the pairs leave a scan unreached or
+/// a scan no longer loads, Cancelled when `stop_requested` fires during
+/// fusion, std::runtime_error when an output cannot be written.
 AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registered, PairStore& store,
                          MapProgressSink& progress, const MapOutputPaths& outputs,
                          const std::function<bool()>& stop_requested = {},

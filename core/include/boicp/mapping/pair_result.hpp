@@ -50,11 +50,9 @@ struct PairResult {
 PairResult MakePairResult(const PairIndex& pair, const RegistrationResult& registration,
                           uint64_t seed);
 
-/// The overlap the keyframe planner uses: the overlap, or the fitness for
-/// results stored before overlap was computed.
-double PlannerOverlap(const PairResult& result);
-
-/// What the keyframe planner reads of a finished pair.
+/// What the keyframe planner reads of a finished pair: its overlap (the
+/// fitness for results stored before overlap was computed), its reach (0
+/// when unknown) and whether it is doubtful.
 KeyframePlanner::ProbeOutcome ProbeOutcomeOf(const PairResult& result);
 
 /// The pose-graph edge of a finished pair, weighted by its confidence.
