@@ -88,6 +88,16 @@ void MigratePairFile(json& j, const std::string& path) {
   j["format"] = kPairFileFormat;
 }
 
+// `result` in `format`, with the paths of its two scans (pair files and
+// pairs.json name them for whoever reads them).
+json ResultWithScanPaths(const std::vector<ScanSource>& scans, const PairResult& result,
+                         PairResultFormat format) {
+  json out = settings::PairResultToJson(result, format);
+  out["source_path"] = scans.at(static_cast<size_t>(result.pair.source)).path;
+  out["target_path"] = scans.at(static_cast<size_t>(result.pair.target)).path;
+  return out;
+}
+
 }  // namespace
 
 json PairSettings(const std::vector<ScanSource>& scans, const PairIndex& pair,
@@ -104,18 +114,13 @@ std::string PairFilePath(const std::string& out_dir, const PairIndex& pair) {
 }
 
 json PairListingJson(const std::vector<ScanSource>& scans, const PairResult& result) {
-  json out = settings::PairResultToJson(result, kPairListing);
-  out["source_path"] = scans.at(static_cast<size_t>(result.pair.source)).path;
-  out["target_path"] = scans.at(static_cast<size_t>(result.pair.target)).path;
-  return out;
+  return ResultWithScanPaths(scans, result, kPairListing);
 }
 
 void WritePairFile(const std::string& out_dir, const std::vector<ScanSource>& scans,
                    const PairResult& result, const json& settings) {
   std::filesystem::create_directories(std::filesystem::path(out_dir) / "pairs");
-  json out = settings::PairResultToJson(result, kPairFile);
-  out["source_path"] = scans.at(static_cast<size_t>(result.pair.source)).path;
-  out["target_path"] = scans.at(static_cast<size_t>(result.pair.target)).path;
+  json out = ResultWithScanPaths(scans, result, kPairFile);
   out["settings"] = settings;
   out["format"] = kPairFileFormat;
   WriteTextFileAtomically(PairFilePath(out_dir, result.pair), out.dump(1) + "\n");

@@ -2,13 +2,11 @@
 // how they decode, not their context), the job store keeping a scan's first
 // record (JobStore::PutScan), and a batch's scan context kept with its job.
 
-#include <unistd.h>
-
-#include <filesystem>
 #include <optional>
 
 #include <gmock/gmock.h>
 
+#include "../support/files_and_processes.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "job_store.hpp"
 #include "scan_metadata_once.hpp"
@@ -17,7 +15,6 @@
 namespace boicp::server {
 namespace {
 
-namespace fs = std::filesystem;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
@@ -94,12 +91,9 @@ TEST(MetadataDifferences, ARefusalNamesTheScanAndWhatToDo) {
 }
 
 TEST(ScanRecords, TheFirstRecordStaysAndOnlyAMissingProfileIsFilledIn) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("boicp_scan_records_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::ScratchDir dir("boicp_scan_records");
   {
-    JobStore store((dir / "jobs.sqlite").string());
+    JobStore store((dir.path() / "jobs.sqlite").string());
     v1::ScanMetadata first = DepthScan();
     first.set_sha256(std::string(64, 'b'));
     first.set_timestamp(1);
@@ -120,18 +114,14 @@ TEST(ScanRecords, TheFirstRecordStaysAndOnlyAMissingProfileIsFilledIn) {
     EXPECT_EQ(filled.ranges.counts, profile.counts);
     EXPECT_EQ(store.GetScan(first.sha256())->metadata.timestamp(), 1);
   }
-  fs::remove_all(dir);
 }
 
 // A batch's scan context is part of the request stored with the job, so a
 // resumed job reads it again; the scans' snapshot stays their stored records.
 TEST(JobInputs, TheBatchsScanContextIsStoredWithTheJob) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("boicp_job_inputs_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::ScratchDir dir("boicp_job_inputs");
   {
-    JobStore store((dir / "jobs.sqlite").string());
+    JobStore store((dir.path() / "jobs.sqlite").string());
     JobInput input;
     v1::ScanMetadata scan = DepthScan();
     scan.set_sha256(std::string(64, 'c'));
@@ -154,7 +144,6 @@ TEST(JobInputs, TheBatchsScanContextIsStoredWithTheJob) {
     ASSERT_EQ(read->scans.size(), 2u);
     EXPECT_EQ(read->scans[1].timestamp(), 1);
   }
-  fs::remove_all(dir);
 }
 
 }  // namespace
