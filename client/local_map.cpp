@@ -19,15 +19,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-MapBatch RunBatch(const LocalRun& run, PairingPlan plan) {
-  MapBatch batch;
-  batch.scans = run.folder.scans;
-  batch.config = run.config;
-  batch.map = run.map;
-  batch.plan = std::move(plan);
-  return batch;
-}
-
 MapOutputPaths LocalOutputPaths(const std::string& out_dir) {
   const fs::path dir(out_dir);
   MapOutputPaths paths;
@@ -57,8 +48,8 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
                                         const std::string& out_dir) {
   const fs::path dir(out_dir);
   UpDetectionOptions up_options;
-  if (!run.folder.scans.empty())
-    up_options.sensor_up = SensorUp(run.config.sensor, run.folder.scans[0].load.format);
+  if (!run.batch.scans.empty())
+    up_options.sensor_up = SensorUp(run.batch.config.sensor, run.batch.scans[0].load.format);
   const UpDirection up = WriteMapPreview(LocalOutputPaths(out_dir).octomap_bt, map.estimate.poses,
                                          (dir / "preview.png").string(), {}, up_options);
   std::fprintf(stderr, "preview: %s\n", up.reason.c_str());
@@ -67,7 +58,7 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   json listing = json::array();
   for (PairResult& r : listed) {
     r.in_graph = in_graph.count(r.pair) > 0;
-    listing.push_back(PairListingJson(run.folder.scans, r));
+    listing.push_back(PairListingJson(run.batch.scans, r));
   }
   WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
 
@@ -114,7 +105,7 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
 }
 
 MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads) {
-  const MapBatch batch = RunBatch(run, run.plan);
+  const MapBatch& batch = run.batch;
   PairFileStore store(batch.scans, batch.config, out_dir);
   TerminalProgress progress;
   fs::create_directories(out_dir);
@@ -135,11 +126,11 @@ MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, 
 
 int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
                        const std::string& out_dir, int threads) {
-  const MapBatch batch = RunBatch(run, PlanFixedPairs(pairs));
+  const MapBatch& batch = run.batch;
   PairFileStore store(batch.scans, batch.config, out_dir);
   TerminalProgress progress;
   ThreadPool pool(threads);
-  RegisterPlannedPairs(batch.scans, batch.config, batch.plan, store, progress,
+  RegisterPlannedPairs(batch.scans, batch.config, PlanFixedPairs(pairs), store, progress,
                        LocalExecution(pool));
   progress.FinishPairs();
   return progress.reused();
@@ -148,7 +139,7 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,
                                      const std::map<PairIndex, PairResult>& results,
                                      const std::string& out_dir) {
-  const MapBatch batch = RunBatch(run, run.plan);
+  const MapBatch& batch = run.batch;
   RegisteredPairs registered;
   registered.finished = results;
   registered.chain = batch.plan.chain;

@@ -30,7 +30,7 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
 /// The whole run into OUTDIR: every pair (reusing files with the run's
 /// settings), then map.bt, map.ot, trajectory.tum, trajectory.kitti,
 /// pairs.json and preview.png. Throws the first failure.
-/// Precondition: ChooseRunSettings(run) was called; threads >= 1.
+/// Precondition: run.chosen = ChooseBatchSettings(run.batch) was called; threads >= 1.
 MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads);
 
 /// A shard's share: registers `pairs` into OUTDIR/pairs (reusing files with
@@ -39,7 +39,7 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
                        const std::string& out_dir, int threads);
 
 /// `boicp merge`: the map from results already read (ReadStoredPairs, one
-/// per pair of run.plan), written to OUTDIR as BuildLocalMap does.
+/// per pair of run.batch.plan), written to OUTDIR as BuildLocalMap does.
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,
                                      const std::map<PairIndex, PairResult>& results,
                                      const std::string& out_dir);

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "boicp/settings/requested_settings.hpp"
+#include "boicp/settings/map_batch_request.hpp"
 #include "boicp/settings/setting_schema.hpp"
 #include "boicp/settings/settings_json.hpp"
 #include "cli_parsing.hpp"
@@ -19,14 +19,6 @@ std::string JoinNames(const std::vector<std::string>& names) {
   std::string joined;
   for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
   return joined;
-}
-
-BoIcpConfig BuildConfig(const MapSettings& s) {
-  BoIcpConfig config = settings::ConfigFromSettings(s);
-  // Parallelism is across pairs; inside one registration it is one thread,
-  // as the daemon's default --registration-threads.
-  config.threads = 1;
-  return config;
 }
 
 ScanFolderOptions FolderOptions(const MapSettings& s) {
@@ -139,63 +131,48 @@ PairingRequest PairingOfSettings(const MapSettings& settings) {
 LocalRun PrepareRun(const MapSettings& settings) {
   LocalRun run;
   run.settings = settings;
-  run.config = BuildConfig(settings);
-  // Unset map settings keep OccupancySettings' fixed defaults until
-  // ChooseRunSettings replaces them.
-  try {
-    run.map = boicp::settings::MapBuildFromSettings(settings);
-  } catch (const InputError& e) {
-    throw InputError(std::string("map settings: ") + e.what());
-  }
-  run.map_auto = boicp::settings::MapAutoFromSettings(settings);
-  run.folder = ReadScanFolder(settings.path, FolderOptions(settings));
-  const int n = static_cast<int>(run.folder.scans.size());
+  ScanFolder folder = ReadScanFolder(settings.path, FolderOptions(settings));
+  const int n = static_cast<int>(folder.scans.size());
   if (n < 2) {
     throw InputError(settings.path + ": a map needs at least 2 scans, the selection has " +
                      std::to_string(n));
   }
-  run.pairing = PairingOfSettings(settings);
-  run.plan =
-      PlanPairing(run.pairing, run.folder.scans, run.config.sensor,
-                  settings.pairing == "explicit" ? settings.pairs_file : settings.extra_pairs_file);
+  run.layout = folder.layout;
+  run.description = std::move(folder.description);
+  // Parallelism is across pairs; inside one registration it is one thread,
+  // as the daemon's default --registration-threads.
+  run.batch = boicp::settings::MakeMapBatch(
+      std::move(folder.scans), settings, PairingOfSettings(settings), 1,
+      settings.pairing == "explicit" ? settings.pairs_file : settings.extra_pairs_file);
   return run;
-}
-
-void ChooseRunSettings(LocalRun& run) {
-  BatchSettingsChoice choice =
-      ApplyBatchSettings(run.folder.scans, run.config, run.map.occupancy, run.map_auto);
-  run.auto_fields = std::move(choice.fields);
-  run.measured = std::move(choice.measured);
-  run.sensor = choice.sensor;
-  run.sensor_reason = std::move(choice.sensor_reason);
-  run.map_auto = {false, false};
-  ValidateConfig(run.config);
-  ValidateOccupancySettings(run.map.occupancy);
 }
 
 void ApplyResourceLimits(LocalRun& run, const std::vector<RangeProfile>& profiles,
                          uint64_t max_fusion_mb) {
-  RequireVoxelsFitExtent(run.config, ProfilesExtent(profiles));
-  run.map.max_fusion_bytes = static_cast<size_t>(max_fusion_mb << 20);
-  RequireFusionWithinLimit(run.folder.scans, profiles, run.map.occupancy, run.map.max_fusion_bytes);
+  MapBatch& batch = run.batch;
+  RequireVoxelsFitExtent(batch.config, ProfilesExtent(profiles));
+  batch.map.max_fusion_bytes = static_cast<size_t>(max_fusion_mb << 20);
+  RequireFusionWithinLimit(batch.scans, profiles, batch.map.occupancy, batch.map.max_fusion_bytes);
 }
 
 void PrintRunSettings(const LocalRun& run) {
+  const BoIcpConfig& config = run.batch.config;
+  const OccupancySettings& occupancy = run.batch.map.occupancy;
   std::fprintf(
       stderr,
       "settings: voxel %.3g m, refine voxel %.3g m, translation bounds %.3g,%.3g,%.3g m, "
       "rotation bounds %.3g,%.3g,%.3g rad, map resolution %.3g m, ray length %.3g m%s%s\n",
-      run.config.voxel, run.config.EffectiveRefineVoxel(), run.config.translation_bounds[0],
-      run.config.translation_bounds[1], run.config.translation_bounds[2],
-      run.config.rotation_bounds[0], run.config.rotation_bounds[1], run.config.rotation_bounds[2],
-      run.map.occupancy.resolution, run.map.occupancy.max_range,
-      run.auto_fields.empty() ? "" : "; from the scans: ", JoinNames(run.auto_fields).c_str());
-  if (!run.measured.empty()) {
-    std::fprintf(stderr, "settings: sensor %s (%s)\n", SensorKindName(run.sensor).c_str(),
-                 run.sensor_reason.c_str());
+      config.voxel, config.EffectiveRefineVoxel(), config.translation_bounds[0],
+      config.translation_bounds[1], config.translation_bounds[2], config.rotation_bounds[0],
+      config.rotation_bounds[1], config.rotation_bounds[2], occupancy.resolution,
+      occupancy.max_range,
+      run.chosen.fields.empty() ? "" : "; from the scans: ", JoinNames(run.chosen.fields).c_str());
+  if (!run.chosen.measured.empty()) {
+    std::fprintf(stderr, "settings: sensor %s (%s)\n", SensorKindName(run.chosen.sensor).c_str(),
+                 run.chosen.sensor_reason.c_str());
   }
   size_t far_returns = 0, scans_with_far_returns = 0;
-  for (const MeasuredScan& m : run.measured) {
+  for (const MeasuredScan& m : run.chosen.measured) {
     far_returns += m.far_returns;
     scans_with_far_returns += m.far_returns > 0;
   }
@@ -203,23 +180,24 @@ void PrintRunSettings(const LocalRun& run) {
     std::fprintf(stderr,
                  "settings: %zu points of %zu of the %zu measured scans set aside as far returns "
                  "(they stay in the scans; run.json lists them)\n",
-                 far_returns, scans_with_far_returns, run.measured.size());
+                 far_returns, scans_with_far_returns, run.chosen.measured.size());
   }
 }
 
 json RunManifestJson(const LocalRun& run) {
   json manifest = MapSettingsToJson(run.settings);
-  manifest["chosen"] = settings::ConfigToJson(run.config);
-  manifest["chosen"]["map_resolution"] = run.map.occupancy.resolution;
-  manifest["chosen"]["map_max_range"] = run.map.occupancy.max_range;
-  manifest["auto"] = run.auto_fields;
+  manifest["chosen"] = settings::ConfigToJson(run.batch.config);
+  manifest["chosen"]["map_resolution"] = run.batch.map.occupancy.resolution;
+  manifest["chosen"]["map_max_range"] = run.batch.map.occupancy.max_range;
+  manifest["auto"] = run.chosen.fields;
   manifest["far_returns"] = json::array();
-  for (const MeasuredScan& m : run.measured) {
+  for (const MeasuredScan& m : run.chosen.measured) {
     manifest["far_returns"].push_back(
-        {{"scan", run.folder.scans[m.scan].path}, {"points", m.far_returns}});
+        {{"scan", run.batch.scans[m.scan].path}, {"points", m.far_returns}});
   }
-  if (!run.measured.empty()) {
-    manifest["sensor"] = {{"type", SensorKindName(run.sensor)}, {"why", run.sensor_reason}};
+  if (!run.chosen.measured.empty()) {
+    manifest["sensor"] = {{"type", SensorKindName(run.chosen.sensor)},
+                          {"why", run.chosen.sensor_reason}};
   }
   return manifest;
 }
@@ -240,7 +218,7 @@ std::map<PairIndex, PairResult> ReadStoredPairs(const LocalRun& run,
     for (const std::string& dir : dirs) {
       std::optional<PairFile> file = ReadPairFile(dir, pair);
       if (!file) continue;
-      if (file->settings != PairSettings(run.folder.scans, pair, run.config)) {
+      if (file->settings != PairSettings(run.batch.scans, pair, run.batch.config)) {
         throw InputError(PairFilePath(dir, pair) + ": computed with other settings than " +
                          RunManifestPath(dir) + " (rerun that shard)");
       }

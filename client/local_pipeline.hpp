@@ -14,8 +14,8 @@
 
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/mapping/batch_pair.hpp"
-#include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/fusion_memory.hpp"
+#include "boicp/mapping/map_batch.hpp"
 #include "boicp/settings/requested_settings.hpp"
 #include "local_pairs.hpp"
 
@@ -45,25 +45,15 @@ MapSettings MapSettingsFromJson(const nlohmann::json& json, const std::string& s
 /// A run resolved from its settings.
 struct LocalRun {
   MapSettings settings;
-  ScanFolder folder;
-  BoIcpConfig config;  // config.seed is the job seed; one thread per registration
-  MapBuildSettings map;
-  MapAutoFields map_auto;                  // map settings still to be chosen from the scans
-  std::vector<std::string> auto_fields;    // the settings ChooseRunSettings chose
-  std::vector<MeasuredScan> measured;      // the scans it chose them from
-  SensorKind sensor = SensorKind::kOther;  // the sensor it took them for, when it measured
-  std::string sensor_reason;               // and why
-  PairingRequest pairing;                  // as the settings ask, pairs read from their files
-  PairingPlan plan;                        // PlanPairing of `pairing`
+  ScanLayout layout = ScanLayout::kAuto;  // the folder's layout (never kAuto)
+  std::string description;                // the folder in one line (ScanFolder::description)
+  MapBatch batch;                         // one thread per registration
+  BatchSettingsChoice chosen;             // what ChooseBatchSettings chose, and from which scans
 };
 
 /// Reads the folder and validates everything (config, map settings,
 /// pairs). Scans are not loaded. Throws InputError naming the field or file.
 LocalRun PrepareRun(const MapSettings& settings);
-
-/// Chooses the settings the user left automatic from the run's scans
-/// (ApplyBatchSettings), once for the whole run.
-void ChooseRunSettings(LocalRun& run);
 
 /// Checks the run's chosen settings against its scans and sets its fusion
 /// memory limit to `max_fusion_mb` MiB (0 = none): throws InputError for a

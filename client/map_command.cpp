@@ -69,7 +69,7 @@ void ClaimShardManifest(const LocalRun& run, const std::string& out) {
 // writes only their files and the manifest; `boicp merge` builds the map.
 int RunShard(const LocalRun& run, const Shard& shard, const MapFlags& flags) {
   const std::string& out = flags.out_dir;
-  const std::vector<PairIndex> all = FixedPlanPairs(run.plan);
+  const std::vector<PairIndex> all = FixedPlanPairs(run.batch.plan);
   std::vector<PairIndex> mine;
   for (size_t i = 0; i < all.size(); ++i) {
     if (static_cast<int>(i % static_cast<size_t>(shard.count)) == shard.index - 1) {
@@ -110,8 +110,8 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
          {"map.bt", "map.ot", "trajectory.tum", "trajectory.kitti", "pairs.json", "preview.png"}) {
       outputs[name] = (fs::path(out) / name).string();
     }
-    std::cout << json{{"layout", ScanLayoutName(run.folder.layout)},
-                      {"scans", run.folder.scans.size()},
+    std::cout << json{{"layout", ScanLayoutName(run.layout)},
+                      {"scans", run.batch.scans.size()},
                       {"pairs", summary.pairs},
                       {"pairs_reused", summary.pairs_reused},
                       {"pairs_doubtful", summary.pairs_doubtful},
@@ -138,18 +138,18 @@ int RunMap(MapFlags flags) {
     const std::string& out = flags.out_dir;
     const bool sharded = !flags.shard.empty();
     const Shard shard = sharded ? ParseShard(flags.shard) : Shard{};
-    if (sharded && run.plan.keyframes) {
+    if (sharded && run.batch.plan.keyframes) {
       throw InputError(
           "--shard: overlap pairing chooses its pairs as results come in; shard "
           "consecutive or explicit pairing");
     }
     if (sharded) CheckShardManifest(run, out);
-    const std::vector<RangeProfile> profiles = ProfileScans(run.folder.scans, flags.threads);
-    ChooseRunSettings(run);
+    const std::vector<RangeProfile> profiles = ProfileScans(run.batch.scans, flags.threads);
+    run.chosen = ChooseBatchSettings(run.batch);
     // Shards fuse nothing, but their merge would refuse what this refuses.
     ApplyResourceLimits(run, profiles, flags.max_fusion_mb);
-    run.map.fusion_threads = flags.threads;
-    std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.folder.description.c_str());
+    run.batch.map.fusion_threads = flags.threads;
+    std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.description.c_str());
     PrintRunSettings(run);
     if (!sharded) return BuildMap(run, flags, start);
     ClaimShardManifest(run, out);

@@ -41,23 +41,24 @@ MapSettings AgreedManifest(const std::vector<std::string>& dirs) {
 int RunMerge(const MergeFlags& flags) {
   try {
     LocalRun run = PrepareRun(AgreedManifest(flags.shard_dirs));
-    if (run.plan.keyframes) {
+    if (run.batch.plan.keyframes) {
       throw InputError(RunManifestPath(flags.shard_dirs.front()) +
                        ": overlap pairing is not sharded; run boicp map instead");
     }
-    ChooseRunSettings(run);  // the shards' own choice: the same scans give the same settings
+    run.chosen = ChooseBatchSettings(
+        run.batch);  // the shards' own choice: the same scans give the same settings
     const std::map<PairIndex, PairResult> results =
-        ReadStoredPairs(run, FixedPlanPairs(run.plan), flags.shard_dirs);
-    ApplyResourceLimits(run, ProfileScans(run.folder.scans, AvailableCores()), flags.max_fusion_mb);
-    std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(),
-                 run.folder.description.c_str(), results.size());
+        ReadStoredPairs(run, FixedPlanPairs(run.batch.plan), flags.shard_dirs);
+    ApplyResourceLimits(run, ProfileScans(run.batch.scans, AvailableCores()), flags.max_fusion_mb);
+    std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(), run.description.c_str(),
+                 results.size());
     PrintRunSettings(run);
     fs::create_directories(flags.out_dir);
     WriteTextFileAtomically(RunManifestPath(flags.out_dir), RunManifestJson(run).dump(1) + "\n");
     const MapOutputSummary summary = AssembleStoredPairs(run, results, flags.out_dir);
     PrintMapClosing(summary, flags.out_dir);
     if (flags.json) {
-      std::cout << json{{"scans", run.folder.scans.size()},
+      std::cout << json{{"scans", run.batch.scans.size()},
                         {"pairs", results.size()},
                         {"pairs_doubtful", summary.pairs_doubtful},
                         {"pose_graph_optimised", summary.optimised},

@@ -32,16 +32,13 @@ struct SubmitFlags {
 v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
   const MapSettings& s = run.settings;
   v1::SubmitBatchRequest request;
-  *request.mutable_pairing() = rpc::PairingToProto(run.pairing);
+  *request.mutable_pairing() = rpc::PairingToProto(run.batch.pairing);
   *request.mutable_config() = rpc::RegistrationConfigToProto(s);
-  // The map settings PrepareRun leaves to the daemon (sensor model, cloud
-  // voxel) are checked here too, before any upload.
-  settings::MapBuildFromSettings(s);
   *request.mutable_map() = rpc::MapSettingsToProto(s);
   if (s.fixed_settings) {
     // The fixed map settings, as this client validated them.
-    request.mutable_map()->set_resolution(run.map.occupancy.resolution);
-    request.mutable_map()->set_max_range(run.map.occupancy.max_range);
+    request.mutable_map()->set_resolution(run.batch.map.occupancy.resolution);
+    request.mutable_map()->set_max_range(run.batch.map.occupancy.max_range);
   }
   request.set_label(f.label.empty() ? s.path : f.label);
   return request;
@@ -49,7 +46,8 @@ v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
 
 // Uploads every scan (only metadata for bytes the daemon already holds),
 // with progress on stderr; returns the scan ids in order.
-std::vector<std::string> UploadScans(rpc::MapBuilderClient& client, const ScanFolder& folder,
+std::vector<std::string> UploadScans(rpc::MapBuilderClient& client,
+                                     const std::vector<ScanSource>& scans,
                                      const std::vector<v1::ScanMetadata>& metadata) {
   const bool terminal = StderrIsTerminal();
   const auto start = Clock::now();
@@ -57,9 +55,9 @@ std::vector<std::string> UploadScans(rpc::MapBuilderClient& client, const ScanFo
   std::vector<std::string> ids;
   uint64_t sent_bytes = 0;
   int already = 0;
-  const size_t n = folder.scans.size();
+  const size_t n = scans.size();
   for (size_t i = 0; i < n; ++i) {
-    const v1::UploadScanResponse response = client.UploadFile(folder.scans[i].path, metadata[i]);
+    const v1::UploadScanResponse response = client.UploadFile(scans[i].path, metadata[i]);
     ids.push_back(response.scan_id());
     if (response.already_present()) {
       ++already;
@@ -84,27 +82,26 @@ std::vector<std::string> UploadScans(rpc::MapBuilderClient& client, const ScanFo
 
 int RunSubmit(SubmitFlags& f) {
   const LocalRun run = PrepareRun(ResolveMapSettings(f.map));
-  const ScanFolder& folder = run.folder;
+  const std::vector<ScanSource>& scans = run.batch.scans;
   v1::SubmitBatchRequest request = BuildRequest(f, run);
   std::vector<v1::ScanMetadata> metadata;
-  for (const ScanSource& scan : folder.scans) metadata.push_back(rpc::ScanMetadataOf(scan));
+  for (const ScanSource& scan : scans) metadata.push_back(rpc::ScanMetadataOf(scan));
 
   Daemon daemon = ConnectToDaemon(f.remote);
   daemon.client->ListJobs(1);  // reachable and the token accepted, before the slow checks
   const auto check_start = Clock::now();
-  CheckScansLoad(folder, AvailableCores());
+  CheckScansLoad(scans, AvailableCores());
   std::fprintf(stderr, "%s: %s; every scan loads (checked in %.1f s)\n", run.settings.path.c_str(),
-               folder.description.c_str(),
+               run.description.c_str(),
                std::chrono::duration<double>(Clock::now() - check_start).count());
 
-  for (const std::string& id : UploadScans(*daemon.client, folder, metadata)) {
+  for (const std::string& id : UploadScans(*daemon.client, scans, metadata)) {
     request.add_scan_ids(id);
   }
   // Every scan's context (sensor origin, prior pose, timestamp) goes with the
   // batch: the daemon keeps a scan's first upload's as a default only, so a
   // second submit of the same scans with other priors or times uses its own.
-  for (const ScanSource& scan : folder.scans)
-    *request.add_scan_context() = rpc::ScanContextOf(scan);
+  for (const ScanSource& scan : scans) *request.add_scan_context() = rpc::ScanContextOf(scan);
   const v1::Job job = daemon.client->Submit(request);
   std::printf("%s\n", job.job_id().c_str());
   std::fflush(stdout);

@@ -102,10 +102,11 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   }
   const JobSpec spec =
       BuildJobSpec("new", request, input.scans, data_dir_, options_.registration_threads);
-  RequireVoxelsFitExtent(spec.config, ProfilesExtent(profiles));
+  const MapBatch& batch = spec.batch;
+  RequireVoxelsFitExtent(batch.config, ProfilesExtent(profiles));
   // Map settings chosen from the scans are checked when the job starts.
-  if (!spec.map_auto.resolution && !spec.map_auto.max_range) {
-    RequireFusionWithinLimit(spec.scans, profiles, spec.map.occupancy, options_.max_fusion_bytes);
+  if (!batch.map_auto.resolution && !batch.map_auto.max_range) {
+    RequireFusionWithinLimit(batch.scans, profiles, batch.map.occupancy, options_.max_fusion_bytes);
   }
   RequireStorage(data_dir_, options_.min_free_bytes);
 
@@ -134,8 +135,8 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   job.set_stage("queued");
   job.set_num_scans(static_cast<uint32_t>(request.scan_ids_size()));
   // A keyframe plan registers at least one pair per scan after the first.
-  const size_t planned = (spec.plan.keyframes ? spec.scans.size() - 1 : spec.plan.chain.size()) +
-                         spec.plan.extras.size();
+  const size_t planned = (batch.plan.keyframes ? batch.scans.size() - 1 : batch.plan.chain.size()) +
+                         batch.plan.extras.size();
   job.set_pairs_total(static_cast<uint32_t>(planned));
   job.set_eta_seconds(-1.0);
   job.set_created_at(rpc::NowSeconds());
@@ -144,7 +145,7 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   queue_changed_.notify_one();
   Publish(job);
   spdlog::info("job {} queued: {} scans, {} pairs planned, preset {}, label '{}'", job.job_id(),
-               job.num_scans(), job.pairs_total(), spec.config.preset, EscapeForLog(job.label()));
+               job.num_scans(), job.pairs_total(), batch.config.preset, EscapeForLog(job.label()));
   return job;
 }
 

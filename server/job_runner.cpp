@@ -51,7 +51,7 @@ class JobRun : public MapProgressSink {
   RunOutcome Run() {
     try {
       Prepare();
-      JobPairStore pairs(ctx_.store, batch_spec_);
+      JobPairStore pairs(ctx_.store, spec_);
       pairs_ = &pairs;
       PairExecution execution;
       execution.submit = [this](std::function<void()> task) { ctx_.pool.Submit(std::move(task)); };
@@ -62,7 +62,7 @@ class JobRun : public MapProgressSink {
       MapPipelineHooks hooks;
       hooks.before_fusion = [this] { PrepareFusion(); };
       const MapPipelineResult result =
-          RunMapPipeline(batch_, pairs, *this, execution,
+          RunMapPipeline(spec_.batch, pairs, *this, execution,
                          JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id())), hooks);
       pairs_ = nullptr;
       return Finish(result);
@@ -80,32 +80,27 @@ class JobRun : public MapProgressSink {
   void Prepare() {
     const std::optional<JobInput> input = ctx_.store.GetJobInput(job_.job_id());
     if (!input) throw std::runtime_error("the job's input is missing from the data store");
-    batch_spec_ = BuildJobSpec(job_.job_id(), input->request, input->scans, ctx_.data_dir,
-                               ctx_.registration_threads);
+    spec_ = BuildJobSpec(job_.job_id(), input->request, input->scans, ctx_.data_dir,
+                         ctx_.registration_threads);
     // Every load of the job's scans (settings, pairs, fusion) shares the
     // daemon's decode budget with the uploads, and stops waiting for it
     // when the job stops.
-    for (ScanSource& scan : batch_spec_.scans) {
+    for (ScanSource& scan : spec_.batch.scans) {
       scan.load.decode_budget = ctx_.decode_budget;
       scan.load.decode_stop = [this] { return control_.StopRequested(); };
     }
     VerifyScans();
     // Chosen once from the job's scans; a resumed job chooses the same again.
-    const BatchSettingsChoice choice = ApplyBatchSettings(
-        batch_spec_.scans, batch_spec_.config, batch_spec_.map.occupancy, batch_spec_.map_auto);
-    *job_.mutable_settings() = ChosenSettingsToProto(batch_spec_.config, batch_spec_.map, choice);
+    const BatchSettingsChoice choice = ChooseBatchSettings(spec_.batch);
+    *job_.mutable_settings() = ChosenSettingsToProto(spec_.batch.config, spec_.batch.map, choice);
     job_.mutable_settings()->set_scan_format(
-        rpc::ScanFormatOf(batch_spec_.scans.at(0).load.format));
-    batch_.scans = batch_spec_.scans;
-    batch_.config = batch_spec_.config;
-    batch_.map = batch_spec_.map;
+        rpc::ScanFormatOf(spec_.batch.scans.at(0).load.format));
     // Fusion starts once this job's pairs are done; its ray casting takes one
     // thread per worker (the map does not depend on the count).
-    batch_.map.fusion_threads = ctx_.pool.size();
-    batch_.map.max_fusion_bytes = ctx_.max_fusion_bytes;
-    RequireFusionWithinLimit(batch_.scans, ScanProfiles(), batch_.map.occupancy,
+    spec_.batch.map.fusion_threads = ctx_.pool.size();
+    spec_.batch.map.max_fusion_bytes = ctx_.max_fusion_bytes;
+    RequireFusionWithinLimit(spec_.batch.scans, ScanProfiles(), spec_.batch.map.occupancy,
                              ctx_.max_fusion_bytes);
-    batch_.plan = batch_spec_.plan;
     job_.set_state(v1::JOB_STATE_RUNNING);
     if (job_.started_at() == 0.0) job_.set_started_at(rpc::NowSeconds());
     if (ctx_.max_job_seconds > 0.0) {
@@ -122,7 +117,7 @@ class JobRun : public MapProgressSink {
   // before profiles were).
   std::vector<RangeProfile> ScanProfiles() const {
     std::vector<RangeProfile> profiles;
-    for (const std::string& scan_id : batch_spec_.scan_ids) {
+    for (const std::string& scan_id : spec_.scan_ids) {
       const std::optional<StoredScan> scan = ctx_.store.GetScan(scan_id);
       profiles.push_back(scan ? scan->ranges : RangeProfile{});
     }
@@ -132,7 +127,7 @@ class JobRun : public MapProgressSink {
   // A scan whose bytes no longer match its name fails the job (the error
   // names it) rather than feeding a wrong cloud into the map.
   void VerifyScans() const {
-    const std::set<std::string> unique(batch_spec_.scan_ids.begin(), batch_spec_.scan_ids.end());
+    const std::set<std::string> unique(spec_.scan_ids.begin(), spec_.scan_ids.end());
     for (const std::string& scan_id : unique) VerifyStoredScan(ctx_.data_dir, scan_id);
   }
 
@@ -143,8 +138,8 @@ class JobRun : public MapProgressSink {
     Persist();
     Publish(nullptr);
     spdlog::info("job {} running: {} scans, {} pairing, preset {}, {} of {} pairs already done",
-                 job_.job_id(), batch_.scans.size(), PairingModeName(batch_spec_.pairing),
-                 batch_.config.preset, counts.done, counts.total);
+                 job_.job_id(), spec_.batch.scans.size(), PairingModeName(spec_.batch.pairing.mode),
+                 spec_.batch.config.preset, counts.done, counts.total);
   }
 
   void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
@@ -252,18 +247,18 @@ class JobRun : public MapProgressSink {
     RequireOutputsWritten(outputs);
     const AssembledMap& map = result.map;
     spdlog::info("job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points",
-                 job_.job_id(), batch_.scans.size(), map.fusion.seconds, map.fusion.occupied_leaves,
-                 map.fusion.cloud_points);
+                 job_.job_id(), spec_.batch.scans.size(), map.fusion.seconds,
+                 map.fusion.occupied_leaves, map.fusion.cloud_points);
     if (map.fusion.points_out_of_range > 0) {
       spdlog::warn("job {}: {} points lie beyond the OctoMap's key range and were left out",
                    job_.job_id(), map.fusion.points_out_of_range);
     }
     std::vector<v1::TrajectoryPose> trajectory;
-    const std::vector<double> stamps = ScanTimestamps(batch_.scans);
-    for (size_t i = 0; i < batch_.scans.size(); ++i) {
+    const std::vector<double> stamps = ScanTimestamps(spec_.batch.scans);
+    for (size_t i = 0; i < spec_.batch.scans.size(); ++i) {
       v1::TrajectoryPose pose;
       pose.set_index(static_cast<uint32_t>(i));
-      pose.set_scan_id(batch_spec_.scan_ids[i]);
+      pose.set_scan_id(spec_.scan_ids[i]);
       rpc::TransformToProto(map.estimate.poses[i], pose.mutable_pose());
       pose.set_timestamp(stamps[i]);
       trajectory.push_back(std::move(pose));
@@ -333,8 +328,7 @@ class JobRun : public MapProgressSink {
   const RunnerContext& ctx_;
   JobControl& control_;
   v1::Job job_;
-  JobSpec batch_spec_;
-  MapBatch batch_;
+  JobSpec spec_;
   JobPairStore* pairs_ = nullptr;  // during the pipeline only
   std::string failure_;            // the first failed pair, named
   int done_this_run_ = 0;

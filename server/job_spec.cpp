@@ -6,6 +6,7 @@
 #include "boicp/mapping/batch_pair.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "boicp/rpc/settings_proto.hpp"
+#include "boicp/settings/map_batch_request.hpp"
 #include "boicp/settings/requested_settings.hpp"
 #include "job_limits.hpp"
 
@@ -43,23 +44,6 @@ void ApplyScanContext(const v1::SubmitBatchRequest& request, int i, const v1::Sc
 
 }  // namespace
 
-BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads) {
-  try {
-    BoIcpConfig config = settings::ConfigFromSettings(rpc::SettingsFromProto(proto, {}));
-    config.threads = threads;
-    return config;
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    // SettingsFromProto already names the field ("config.voxel: ...").
-    if (message.rfind("config.", 0) == 0) throw;
-    throw InputError("config: " + message);
-  }
-}
-
-MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto) {
-  return settings::MapBuildFromSettings(rpc::SettingsFromProto({}, proto));
-}
-
 JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& request,
                      const std::vector<v1::ScanMetadata>& scans, const DataDir& data_dir,
                      int registration_threads) {
@@ -79,6 +63,7 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
                      " scan_ids; send one per scan, in the same order, or none (each scan's "
                      "context as its first upload stored it)");
   }
+  std::vector<ScanSource> sources;
   for (int i = 0; i < n; ++i) {
     const v1::ScanMetadata& meta = scans[static_cast<size_t>(i)];
     ScanSource source;
@@ -88,16 +73,11 @@ JobSpec BuildJobSpec(const std::string& job_id, const v1::SubmitBatchRequest& re
     source.load.max_points = std::numeric_limits<uint64_t>::max();
     ApplyScanContext(request, i, meta, source);
     spec.scan_ids.push_back(request.scan_ids(i));
-    spec.scans.push_back(std::move(source));
+    sources.push_back(std::move(source));
   }
-
-  spec.config = ConfigFromProto(request.config(), registration_threads);
-  const PairingRequest pairing = rpc::PairingFromProto(request.pairing());
-  spec.pairing = pairing.mode;
-  spec.plan = PlanPairing(pairing, spec.scans, spec.config.sensor);
-  spec.map = MapSettingsFromProto(request.map());
-  spec.map_auto =
-      settings::MapAutoFromSettings(rpc::SettingsFromProto(request.config(), request.map()));
+  spec.batch = settings::MakeMapBatch(
+      std::move(sources), rpc::SettingsFromProto(request.config(), request.map()),
+      rpc::PairingFromProto(request.pairing()), registration_threads);
   return spec;
 }
 

@@ -9,9 +9,8 @@
 #include <vector>
 
 #include "boicp/mapping/batch_pair.hpp"
-#include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/map_assembly.hpp"
-#include "boicp/mapping/map_pairs.hpp"
+#include "boicp/mapping/map_batch.hpp"
 #include "boicp/registration/config.hpp"
 #include "boicp/v1/map_builder.pb.h"
 #include "data_dir.hpp"
@@ -22,21 +21,9 @@ namespace v1 = ::boicp::v1;
 
 struct JobSpec {
   std::string job_id;
-  std::vector<std::string> scan_ids;
-  std::vector<ScanSource> scans;
-  PairingMode pairing = PairingMode::kConsecutive;  // as asked
-  PairingPlan plan;                                 // PlanPairing of the request
-  BoIcpConfig config;                               // config.seed is the job seed
-  MapBuildSettings map;
-  MapAutoFields map_auto;  // map settings still to be chosen from the scans
+  std::vector<std::string> scan_ids;  // batch.scans[i] is the stored scan scan_ids[i]
+  MapBatch batch;                     // batch.config.seed is the job seed
 };
-
-/// Preset plus overrides, validated. `threads` is the daemon's setting for
-/// threads inside one registration. Throws InputError naming the field.
-BoIcpConfig ConfigFromProto(const v1::RegistrationConfig& proto, int threads);
-
-/// Map settings with defaults for zero fields, validated. Throws InputError.
-MapBuildSettings MapSettingsFromProto(const v1::MapSettings& proto);
 
 /// The settings a job runs with, for its record: `config` and `map` as
 /// resolved, the names of the fields chosen from the scans and the far

@@ -343,12 +343,12 @@ TEST_F(ScanFolderTest, MissingOrUnrecognisableFolders) {
 
 TEST_F(ScanFolderTest, CheckScansLoadNamesTheFirstBadScanWhateverTheThreads) {
   const fs::path dir = MakeKitti(4, false);
-  EXPECT_NO_THROW(CheckScansLoad(ReadScanFolder(dir.string()), 2));
+  EXPECT_NO_THROW(CheckScansLoad(ReadScanFolder(dir.string()).scans, 2));
   WriteText(dir / "velodyne" / "000001.bin", "12345");  // not a multiple of 16 bytes
   WriteText(dir / "velodyne" / "000003.bin", "123");
   for (const int threads : {1, 4}) {
     const std::string message =
-        InputErrorMessage([&] { CheckScansLoad(ReadScanFolder(dir.string()), threads); });
+        InputErrorMessage([&] { CheckScansLoad(ReadScanFolder(dir.string()).scans, threads); });
     EXPECT_THAT(message, HasSubstr("000001.bin")) << threads << " threads";
     EXPECT_THAT(message, Not(HasSubstr("000003.bin"))) << threads << " threads";
   }
@@ -377,7 +377,7 @@ TEST(ScanFolderRealData, KittiAndSevenScenes) {
   ASSERT_EQ(scenes.scans.size(), 4u);
   EXPECT_EQ(fs::path(scenes.scans[3].path).filename().string(), "frame-000090.depth.png");
   EXPECT_TRUE(scenes.reference_poses[3].has_value());
-  EXPECT_NO_THROW(CheckScansLoad(scenes, 2));
+  EXPECT_NO_THROW(CheckScansLoad(scenes.scans, 2));
 }
 
 }  // namespace

@@ -452,11 +452,11 @@ ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& opti
   return folder;
 }
 
-void CheckScansLoad(const ScanFolder& folder, int threads) {
+void CheckScansLoad(const std::vector<ScanSource>& scans, int threads) {
   // LoadPointCloud's InputError already names the file and the problem, and
-  // ParallelFor rethrows the first scan's in the folder's order.
-  ParallelFor(folder.scans.size(), threads,
-              [&](size_t k) { LoadPointCloud(folder.scans[k].path, folder.scans[k].load); });
+  // ParallelFor rethrows the first scan's in the given order.
+  ParallelFor(scans.size(), threads,
+              [&](size_t k) { LoadPointCloud(scans[k].path, scans[k].load); });
 }
 
 }  // namespace boicp

@@ -53,9 +53,9 @@ struct ScanFolder {
 ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& options = {});
 
 /// Loads every scan once, on at most `threads` threads, and throws
-/// InputError naming the first one in the folder's order that does not load
+/// InputError naming the first one in their order that does not load
 /// (unreadable, truncated, no finite point). Run before uploading or
 /// registering anything.
-void CheckScansLoad(const ScanFolder& folder, int threads);
+void CheckScansLoad(const std::vector<ScanSource>& scans, int threads);
 
 }  // namespace boicp

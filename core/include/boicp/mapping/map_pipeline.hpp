@@ -9,17 +9,10 @@
 #include <vector>
 
 #include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/map_batch.hpp"
 #include "boicp/mapping/pair_scheduler.hpp"
 
 namespace boicp {
-
-/// A batch ready to run: scans, its final settings and its pairing plan.
-struct MapBatch {
-  std::vector<ScanSource> scans;
-  BoIcpConfig config;  // settings chosen (ApplyBatchSettings); config.seed is the batch seed
-  MapBuildSettings map;
-  PairingPlan plan;
-};
 
 /// The pose-graph edges of a batch, in the order EstimatePoses wants them:
 /// the chain, then the plan's extras that do not pair the same two scans as
