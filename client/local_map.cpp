@@ -104,24 +104,45 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
   if (!rungs.empty()) std::fprintf(stderr, "%s\n", rungs.c_str());
 }
 
-MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads) {
+MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads,
+                               const LocalMapHooks& hooks) {
   const MapBatch& batch = run.batch;
   PairFileStore store(batch.scans, batch.config, out_dir);
-  TerminalProgress progress;
+  TerminalProgress terminal;
+  MapProgressSink& progress = hooks.progress ? *hooks.progress : terminal;
   fs::create_directories(out_dir);
   MapPipelineResult result;
   {
     ThreadPool pool(threads);
-    result =
-        RunMapPipeline(batch, store, progress, LocalExecution(pool), LocalOutputPaths(out_dir));
+    PairExecution execution = LocalExecution(pool);
+    execution.stop_requested = hooks.stop_requested;
+    result = RunMapPipeline(batch, store, progress, execution, LocalOutputPaths(out_dir));
   }
   std::vector<PairResult> listed;
   for (const PairIndex& pair : ListedPairs(batch.plan, result.pairs)) {
     listed.push_back(result.pairs.finished.at(pair));
   }
   MapOutputSummary summary = WriteListingAndPreview(run, result.map, listed, out_dir);
-  summary.pairs_reused = progress.reused();
+  summary.pairs_reused = result.pairs.reused;
   return summary;
+}
+
+nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summary,
+                              const std::string& out_dir, double seconds) {
+  json outputs;
+  for (const char* name :
+       {"map.bt", "map.ot", "trajectory.tum", "trajectory.kitti", "pairs.json", "preview.png"}) {
+    outputs[name] = (fs::path(out_dir) / name).string();
+  }
+  return {{"layout", ScanLayoutName(run.layout)},
+          {"scans", run.batch.scans.size()},
+          {"pairs", summary.pairs},
+          {"pairs_reused", summary.pairs_reused},
+          {"pairs_doubtful", summary.pairs_doubtful},
+          {"pose_graph_optimised", summary.optimised},
+          {"occupied_leaves", summary.occupied_leaves},
+          {"runtime_s", seconds},
+          {"outputs", outputs}};
 }
 
 int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
@@ -130,10 +151,10 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
   PairFileStore store(batch.scans, batch.config, out_dir);
   TerminalProgress progress;
   ThreadPool pool(threads);
-  RegisterPlannedPairs(batch.scans, batch.config, PlanFixedPairs(pairs), store, progress,
-                       LocalExecution(pool));
+  const RegisteredPairs registered = RegisterPlannedPairs(
+      batch.scans, batch.config, PlanFixedPairs(pairs), store, progress, LocalExecution(pool));
   progress.FinishPairs();
-  return progress.reused();
+  return registered.reused;
 }
 
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,

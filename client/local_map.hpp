@@ -3,10 +3,14 @@
 // OUTDIR/pairs (PairFileStore), progress on stderr (TerminalProgress),
 // pairs on a pool of --threads workers with one registration thread each.
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "boicp/mapping/map_progress.hpp"
 #include "local_pipeline.hpp"
 
 namespace boicp::cli {
@@ -23,6 +27,15 @@ struct MapOutputSummary {
   std::vector<Rung> answered_by;  // of each pair listed, the rung whose answer was kept
 };
 
+/// What a caller may add to a local run: where progress goes (null: the
+/// terminal, as `boicp map`), and a stop request polled between ICP
+/// evaluations, pairs and fused scans (true: Cancelled, with every finished
+/// pair's file kept for the next run).
+struct LocalMapHooks {
+  MapProgressSink* progress = nullptr;
+  std::function<bool()> stop_requested;
+};
+
 /// What `map` and `merge` close with on stderr: the files written into
 /// `out_dir`, how many pairs are doubtful and how many each rung answered.
 void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir);
@@ -31,7 +44,14 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
 /// settings), then map.bt, map.ot, trajectory.tum, trajectory.kitti,
 /// pairs.json and preview.png. Throws the first failure.
 /// Precondition: run.chosen = ChooseBatchSettings(run.batch) was called; threads >= 1.
-MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads);
+MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads,
+                               const LocalMapHooks& hooks = {});
+
+/// `map --json`'s summary of a run written into `out_dir` in `seconds`:
+/// layout, scans, pairs (reused, doubtful), whether the pose graph was
+/// optimised, occupied leaves, runtime_s and every output file's path.
+nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summary,
+                              const std::string& out_dir, double seconds);
 
 /// A shard's share: registers `pairs` into OUTDIR/pairs (reusing files with
 /// the run's settings), no map. Returns how many were reused.

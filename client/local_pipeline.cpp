@@ -7,6 +7,7 @@
 #include "boicp/settings/map_batch_request.hpp"
 #include "boicp/settings/setting_schema.hpp"
 #include "boicp/settings/settings_json.hpp"
+#include "boicp/util/atomic_file.hpp"
 #include "cli_parsing.hpp"
 
 namespace boicp::cli {
@@ -126,15 +127,13 @@ PairingRequest PairingOfSettings(const MapSettings& settings) {
   return pairing;
 }
 
-}  // namespace
-
-LocalRun PrepareRun(const MapSettings& settings) {
+// The run of `folder`'s scans (from `where`) with `settings`.
+LocalRun RunOfScans(const MapSettings& settings, ScanFolder folder, const std::string& where) {
   LocalRun run;
   run.settings = settings;
-  ScanFolder folder = ReadScanFolder(settings.path, FolderOptions(settings));
   const int n = static_cast<int>(folder.scans.size());
   if (n < 2) {
-    throw InputError(settings.path + ": a map needs at least 2 scans, the selection has " +
+    throw InputError(where + ": a map needs at least 2 scans, the selection has " +
                      std::to_string(n));
   }
   run.layout = folder.layout;
@@ -147,12 +146,35 @@ LocalRun PrepareRun(const MapSettings& settings) {
   return run;
 }
 
-void ApplyResourceLimits(LocalRun& run, const std::vector<RangeProfile>& profiles,
-                         uint64_t max_fusion_mb) {
+}  // namespace
+
+LocalRun PrepareRun(const MapSettings& settings) {
+  return RunOfScans(settings, ReadScanFolder(settings.path, FolderOptions(settings)),
+                    settings.path);
+}
+
+LocalRun PrepareRun(const MapSettings& settings, const std::vector<std::string>& files) {
+  return RunOfScans(settings, ReadScanList(files, FolderOptions(settings)), "the list of scans");
+}
+
+MapSettings WithAbsolutePaths(MapSettings settings) {
+  const auto absolute = [](std::string& path) {
+    if (!path.empty()) path = fs::absolute(path).lexically_normal().string();
+  };
+  absolute(settings.path);
+  absolute(settings.pairs_file);
+  absolute(settings.extra_pairs_file);
+  return settings;
+}
+
+void ChooseMapRunSettings(LocalRun& run, int threads, uint64_t max_fusion_mb) {
   MapBatch& batch = run.batch;
+  const std::vector<RangeProfile> profiles = ProfileScans(batch.scans, threads);
+  run.chosen = ChooseBatchSettings(batch);
   RequireVoxelsFitExtent(batch.config, ProfilesExtent(profiles));
   batch.map.max_fusion_bytes = static_cast<size_t>(max_fusion_mb << 20);
   RequireFusionWithinLimit(batch.scans, profiles, batch.map.occupancy, batch.map.max_fusion_bytes);
+  batch.map.fusion_threads = threads;
 }
 
 void PrintRunSettings(const LocalRun& run) {
@@ -239,6 +261,11 @@ std::map<PairIndex, PairResult> ReadStoredPairs(const LocalRun& run,
 
 std::string RunManifestPath(const std::string& out_dir) {
   return (fs::path(out_dir) / "run.json").string();
+}
+
+void WriteRunManifest(const LocalRun& run, const std::string& out_dir) {
+  fs::create_directories(out_dir);
+  WriteTextFileAtomically(RunManifestPath(out_dir), RunManifestJson(run).dump(1) + "\n");
 }
 
 MapSettings ReadRunManifest(const std::string& dir) {

@@ -55,13 +55,21 @@ struct LocalRun {
 /// pairs). Scans are not loaded. Throws InputError naming the field or file.
 LocalRun PrepareRun(const MapSettings& settings);
 
-/// Checks the run's chosen settings against its scans and sets its fusion
-/// memory limit to `max_fusion_mb` MiB (0 = none): throws InputError for a
-/// voxel too fine for the scans' extent (RequireVoxelsFitExtent) and
-/// LimitExceeded for a map estimated over the limit. `profiles` are the
-/// run's scans' ProfileScans.
-void ApplyResourceLimits(LocalRun& run, const std::vector<RangeProfile>& profiles,
-                         uint64_t max_fusion_mb);
+/// The same for a list of scan files (ReadScanList) in place of
+/// settings.path's folder.
+LocalRun PrepareRun(const MapSettings& settings, const std::vector<std::string>& files);
+
+/// `settings` with the folder and pairs files as absolute paths (run.json
+/// records them so; merge and reruns may start elsewhere).
+MapSettings WithAbsolutePaths(MapSettings settings);
+
+/// What `boicp map` does between PrepareRun and the pairs: the settings left
+/// automatic chosen from the scans (run.chosen), checked against the scans'
+/// extent (RequireVoxelsFitExtent: InputError for a voxel too fine), the
+/// fusion memory limit set to `max_fusion_mb` MiB (0 = none; LimitExceeded
+/// for a map estimated over it; the scans are profiled on `threads`
+/// threads), and fusion set to `threads` threads.
+void ChooseMapRunSettings(LocalRun& run, int threads, uint64_t max_fusion_mb);
 
 /// One "settings: ..." line on stderr: the values used and which were chosen.
 void PrintRunSettings(const LocalRun& run);
@@ -85,6 +93,9 @@ std::map<PairIndex, PairResult> ReadStoredPairs(const LocalRun& run,
 
 /// OUTDIR/run.json, the settings manifest of a run, shard or merge.
 std::string RunManifestPath(const std::string& out_dir);
+
+/// Writes RunManifestJson(run) to OUTDIR/run.json atomically, creating OUTDIR.
+void WriteRunManifest(const LocalRun& run, const std::string& out_dir);
 
 /// The settings in DIR/run.json. Throws InputError naming the file when it
 /// is missing or malformed.

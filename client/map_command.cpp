@@ -7,7 +7,6 @@
 #include <iostream>
 #include <optional>
 
-#include "boicp/util/atomic_file.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "commands.hpp"
 #include "local_map.hpp"
@@ -27,10 +26,6 @@ struct MapFlags {
   uint64_t max_fusion_mb = 0;
   bool json = false;
 };
-
-std::string Absolute(const std::string& path) {
-  return path.empty() ? path : fs::absolute(path).lexically_normal().string();
-}
 
 struct Shard {
   int index = 0;  // K, 1-based
@@ -59,10 +54,7 @@ void CheckShardManifest(const LocalRun& run, const std::string& out) {
 }
 
 void ClaimShardManifest(const LocalRun& run, const std::string& out) {
-  const std::string manifest = RunManifestPath(out);
-  if (fs::exists(manifest)) return;
-  fs::create_directories(out);
-  WriteTextFileAtomically(manifest, RunManifestJson(run).dump(1) + "\n");
+  if (!fs::exists(RunManifestPath(out))) WriteRunManifest(run, out);
 }
 
 // A shard registers the pairs whose index in the plan is K-1 modulo N and
@@ -97,30 +89,14 @@ int RunShard(const LocalRun& run, const Shard& shard, const MapFlags& flags) {
 int BuildMap(const LocalRun& run, const MapFlags& flags,
              std::chrono::steady_clock::time_point start) {
   const std::string& out = flags.out_dir;
-  fs::create_directories(out);
-  WriteTextFileAtomically(RunManifestPath(out), RunManifestJson(run).dump(1) + "\n");
+  WriteRunManifest(run, out);
 
   const MapOutputSummary summary = BuildLocalMap(run, out, flags.threads);
   PrintMapClosing(summary, out);
   if (flags.json) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    json outputs;
-    for (const char* name :
-         {"map.bt", "map.ot", "trajectory.tum", "trajectory.kitti", "pairs.json", "preview.png"}) {
-      outputs[name] = (fs::path(out) / name).string();
-    }
-    std::cout << json{{"layout", ScanLayoutName(run.layout)},
-                      {"scans", run.batch.scans.size()},
-                      {"pairs", summary.pairs},
-                      {"pairs_reused", summary.pairs_reused},
-                      {"pairs_doubtful", summary.pairs_doubtful},
-                      {"pose_graph_optimised", summary.optimised},
-                      {"occupied_leaves", summary.occupied_leaves},
-                      {"runtime_s", seconds},
-                      {"outputs", outputs}}
-                     .dump()
-              << std::endl;
+    std::cout << MapSummaryJson(run, summary, out, seconds).dump() << std::endl;
   }
   return kOk;
 }
@@ -130,11 +106,7 @@ int RunMap(MapFlags flags) {
   try {
     if (flags.out_dir.empty()) throw InputError("-o OUTDIR is required");
     if (flags.threads < 1) throw InputError("--threads: must be >= 1");
-    MapSettings settings = ResolveMapSettings(flags.map);
-    settings.path = Absolute(settings.path);
-    settings.pairs_file = Absolute(settings.pairs_file);
-    settings.extra_pairs_file = Absolute(settings.extra_pairs_file);
-    LocalRun run = PrepareRun(settings);
+    LocalRun run = PrepareRun(WithAbsolutePaths(ResolveMapSettings(flags.map)));
     const std::string& out = flags.out_dir;
     const bool sharded = !flags.shard.empty();
     const Shard shard = sharded ? ParseShard(flags.shard) : Shard{};
@@ -144,11 +116,8 @@ int RunMap(MapFlags flags) {
           "consecutive or explicit pairing");
     }
     if (sharded) CheckShardManifest(run, out);
-    const std::vector<RangeProfile> profiles = ProfileScans(run.batch.scans, flags.threads);
-    run.chosen = ChooseBatchSettings(run.batch);
     // Shards fuse nothing, but their merge would refuse what this refuses.
-    ApplyResourceLimits(run, profiles, flags.max_fusion_mb);
-    run.batch.map.fusion_threads = flags.threads;
+    ChooseMapRunSettings(run, flags.threads, flags.max_fusion_mb);
     std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.description.c_str());
     PrintRunSettings(run);
     if (!sharded) return BuildMap(run, flags, start);

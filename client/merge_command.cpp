@@ -3,10 +3,8 @@
 // missing pairs or other settings, and writes the same outputs as `boicp map`.
 
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 
-#include "boicp/util/atomic_file.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "commands.hpp"
 #include "local_map.hpp"
@@ -15,7 +13,6 @@
 namespace boicp::cli {
 namespace {
 
-namespace fs = std::filesystem;
 using nlohmann::json;
 
 struct MergeFlags {
@@ -45,16 +42,14 @@ int RunMerge(const MergeFlags& flags) {
       throw InputError(RunManifestPath(flags.shard_dirs.front()) +
                        ": overlap pairing is not sharded; run boicp map instead");
     }
-    run.chosen = ChooseBatchSettings(
-        run.batch);  // the shards' own choice: the same scans give the same settings
+    // The shards' own choice: the same scans give the same settings.
+    ChooseMapRunSettings(run, AvailableCores(), flags.max_fusion_mb);
     const std::map<PairIndex, PairResult> results =
         ReadStoredPairs(run, FixedPlanPairs(run.batch.plan), flags.shard_dirs);
-    ApplyResourceLimits(run, ProfileScans(run.batch.scans, AvailableCores()), flags.max_fusion_mb);
     std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(), run.description.c_str(),
                  results.size());
     PrintRunSettings(run);
-    fs::create_directories(flags.out_dir);
-    WriteTextFileAtomically(RunManifestPath(flags.out_dir), RunManifestJson(run).dump(1) + "\n");
+    WriteRunManifest(run, flags.out_dir);
     const MapOutputSummary summary = AssembleStoredPairs(run, results, flags.out_dir);
     PrintMapClosing(summary, flags.out_dir);
     if (flags.json) {

@@ -6,17 +6,13 @@
 #include <iostream>
 #include <optional>
 
-#include <nlohmann/json.hpp>
-
 #include "boicp/io/point_cloud_io.hpp"
-#include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/registration_method.hpp"
 #include "boicp/settings/settings_flags.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "cli_parsing.hpp"
+#include "cloud_registration.hpp"
 #include "commands.hpp"
-#include "json_output.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -90,7 +86,7 @@ void PrintHuman(const RegistrationResult& r) {
 
 int RunRegister(const RegisterFlags& flags) {
   try {
-    BoIcpConfig config = BuildConfig(flags);
+    const BoIcpConfig config = BuildConfig(flags);
     const LoadOptions load = BuildLoadOptions(flags);
     if (!(flags.scale_source > 0.0) || !std::isfinite(flags.scale_source)) {
       throw InputError("--scale-source must be a positive number");
@@ -102,17 +98,16 @@ int RunRegister(const RegisterFlags& flags) {
     const LoadedCloud target = LoadPointCloud(flags.target, load);
     std::optional<Transform> prior;
     if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
-    const ChosenSettings chosen = ChooseSettingsForClouds(
-        {&source.points, &target.points}, DeclareSensor(config.sensor, source.format), config.seed,
-        2, config.threads);
-    const std::vector<std::string> auto_fields = ApplyChosenSettings(chosen, config);
-    ValidateConfig(config);
+    const PairSettingsChoice settings =
+        ChooseCloudPairSettings(source.points, target.points, config, source.format);
+    const ChosenSettings& chosen = settings.chosen;
     if (!flags.quiet) {
       std::fprintf(stderr,
                    "loaded %zu source and %zu target points (%zu and %zu non-finite dropped)\n",
                    source.points.size(), target.points.size(), source.dropped_nonfinite,
                    target.dropped_nonfinite);
-      std::fprintf(stderr, "%s\n", DescribeSettings(config, auto_fields, chosen).c_str());
+      std::fprintf(stderr, "%s\n",
+                   DescribeSettings(settings.config, settings.auto_fields, chosen).c_str());
       if (chosen.far_returns[0] + chosen.far_returns[1] > 0) {
         std::fprintf(stderr,
                      "%zu source and %zu target points set aside as far returns when choosing "
@@ -120,17 +115,10 @@ int RunRegister(const RegisterFlags& flags) {
                      chosen.far_returns[0], chosen.far_returns[1]);
       }
     }
-    PairHints hints;
-    hints.prior = prior;
-    const RegistrationResult result =
-        CoreMethods()
-            .Create(config.method, config)
-            ->RegisterClouds(source.points, target.points, hints, MakeProgressPrinter(flags.quiet));
+    const RegistrationResult result = RegisterCloudPair(source.points, target.points, settings,
+                                                        prior, MakeProgressPrinter(flags.quiet));
     if (flags.json) {
-      nlohmann::json out = RegistrationToJson(result, auto_fields);
-      out["far_returns"] = {{"source", chosen.far_returns[0]}, {"target", chosen.far_returns[1]}};
-      out["sensor"] = {{"type", SensorKindName(chosen.sensor)}, {"why", chosen.sensor_reason}};
-      std::cout << out.dump() << std::endl;
+      std::cout << RegisterReportJson(result, settings).dump() << std::endl;
     } else {
       PrintHuman(result);
     }

@@ -14,6 +14,7 @@
 #include "map_settings_flags.hpp"
 #include "remote_options.hpp"
 #include "remote_watch.hpp"
+#include "submit_request.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -26,23 +27,6 @@ struct SubmitFlags {
   std::string label;
   bool wait = false;
 };
-
-// The batch as PrepareRun validated it; only what the user set overrides
-// the daemon's preset, so both sides apply the same defaults.
-v1::SubmitBatchRequest BuildRequest(const SubmitFlags& f, const LocalRun& run) {
-  const MapSettings& s = run.settings;
-  v1::SubmitBatchRequest request;
-  *request.mutable_pairing() = rpc::PairingToProto(run.batch.pairing);
-  *request.mutable_config() = rpc::RegistrationConfigToProto(s);
-  *request.mutable_map() = rpc::MapSettingsToProto(s);
-  if (s.fixed_settings) {
-    // The fixed map settings, as this client validated them.
-    request.mutable_map()->set_resolution(run.batch.map.occupancy.resolution);
-    request.mutable_map()->set_max_range(run.batch.map.occupancy.max_range);
-  }
-  request.set_label(f.label.empty() ? s.path : f.label);
-  return request;
-}
 
 // Uploads every scan (only metadata for bytes the daemon already holds),
 // with progress on stderr; returns the scan ids in order.
@@ -83,7 +67,7 @@ std::vector<std::string> UploadScans(rpc::MapBuilderClient& client,
 int RunSubmit(SubmitFlags& f) {
   const LocalRun run = PrepareRun(ResolveMapSettings(f.map));
   const std::vector<ScanSource>& scans = run.batch.scans;
-  v1::SubmitBatchRequest request = BuildRequest(f, run);
+  v1::SubmitBatchRequest request = BuildSubmitRequest(run, f.label);
   std::vector<v1::ScanMetadata> metadata;
   for (const ScanSource& scan : scans) metadata.push_back(rpc::ScanMetadataOf(scan));
 
@@ -98,10 +82,6 @@ int RunSubmit(SubmitFlags& f) {
   for (const std::string& id : UploadScans(*daemon.client, scans, metadata)) {
     request.add_scan_ids(id);
   }
-  // Every scan's context (sensor origin, prior pose, timestamp) goes with the
-  // batch: the daemon keeps a scan's first upload's as a default only, so a
-  // second submit of the same scans with other priors or times uses its own.
-  for (const ScanSource& scan : scans) *request.add_scan_context() = rpc::ScanContextOf(scan);
   const v1::Job job = daemon.client->Submit(request);
   std::printf("%s\n", job.job_id().c_str());
   std::fflush(stdout);

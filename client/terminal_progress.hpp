@@ -14,7 +14,6 @@ class PairProgress {
   /// A pair finished (reused: its file was already there).
   void Done(const PairResult& result, bool reused);
   void Finish();
-  int reused() const { return done_ - registered_; }
 
  private:
   int total_;
@@ -35,7 +34,6 @@ class TerminalProgress : public MapProgressSink {
 
   /// Prints the registration summary line, once.
   void FinishPairs();
-  int reused() const { return pairs_.reused(); }
 
  private:
   PairProgress pairs_;

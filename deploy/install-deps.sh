@@ -17,6 +17,7 @@ PACKAGES=(
   libnanoflann-dev libcli11-dev nlohmann-json3-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
+  python3-dev pybind11-dev python3-pytest python3-grpcio python3-protobuf
   clang-format yamllint systemd clang libclang-rt-14-dev
 )
 

@@ -374,17 +374,22 @@ class Client:
 
     # -- jobs -----------------------------------------------------------------
 
-    def submit(self, folder: str, *, label: Optional[str] = None,
-               progress: Optional[ProgressCallback] = None, **settings) -> str:
+    def submit(self, scans: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]], *,
+               label: Optional[str] = None, progress: Optional[ProgressCallback] = None,
+               **settings) -> str:
         """Submits a folder of scans as ``boicp submit FOLDER`` does; returns the job id.
 
-        ``settings`` are ``boicp map``'s run.json keys (``config``, ``voxel``,
+        ``scans`` is the folder, or a list of scan files (their formats from
+        their extensions; depth images need ``intrinsics`` and ``depth_scale``).
+
+        ``settings`` are named as ``boicp.build_map`` takes them (``config``, ``voxel``,
         ``seed``, ``resolution``, ``pairing``, ``first``, ``stride``,
         ``count``, ``layout``, ``poses_as_priors``...). The batch is planned
         by the CLI's own code (``boicp._boicp.plan_submission``, which raises
         ``ValueError`` with the CLI's message on bad input), every scan is
         uploaded (``progress`` as in ``upload_scans``), and the batch is
-        submitted. ``label`` replaces the default label (the folder).
+        submitted. ``label`` replaces the default label (the folder, or the
+        first file's folder).
         """
         # The compiled module is only needed here: the rest of the client is
         # pure Python.
@@ -392,7 +397,9 @@ class Client:
         # Reachable and the token accepted before the plan's checks, which may
         # load every scan: as the CLI, fail fast on the daemon.
         self._unary("ListJobs", pb.ListJobsRequest(page_size=1))
-        plan = planner.plan_submission(str(folder), settings)
+        listed = not isinstance(scans, (str, os.PathLike))
+        plan = planner.plan_submission([os.fspath(s) for s in scans] if listed else os.fspath(scans),
+                                       settings)
         request = pb.SubmitBatchRequest.FromString(plan["request"])
         scans = plan["scans"]
         request.scan_ids[:] = self.upload_scans(

@@ -1,6 +1,7 @@
 """Type stubs of boicp.client (see client.py for the documentation)."""
 
 import enum
+import os
 from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Union
 
 import grpc
@@ -66,7 +67,7 @@ class Client:
     ) -> List[str]: ...
     def submit(
         self,
-        folder: str,
+        scans: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
         *,
         label: Optional[str] = ...,
         progress: Optional[ProgressCallback] = ...,

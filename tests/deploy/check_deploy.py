@@ -286,7 +286,12 @@ def check_runtime_packages(args):
     _, runtime = package_lists(args.root)
     libraries, problems = {}, []
     for binary in (args.boicpd, args.boicp):
-        resolved = dict(re.findall(r"^\s*(\S+) => (\S+)", run(["ldd", binary]), re.M))
+        listing = run(["ldd", binary])
+        resolved = dict(re.findall(r"^\s*(\S+) => (\S+)", listing, re.M))
+        # The dynamic loader, which code built position-independent links for
+        # thread-local storage, is listed by its path alone.
+        for path in re.findall(r"^\s*(/\S+) \(0x", listing, re.M):
+            resolved.setdefault(os.path.basename(path), path)
         for library in re.findall(r"^\s*NEEDED\s+(\S+)", run(["objdump", "-p", binary]), re.M):
             if library in resolved:
                 libraries[library] = resolved[library]

@@ -376,14 +376,26 @@ def test_an_unreachable_daemon_says_so():
         c.get_job("job-1")
 
 
-def test_submit_with_the_real_plan(daemon, scan_folder):
-    planner = pytest.importorskip("boicp._boicp", reason="boicp._boicp is not built")
-    if not hasattr(planner, "plan_submission"):
-        pytest.skip("boicp._boicp has no plan_submission yet")
+@pytest.mark.parametrize("listed", [False, True], ids=["folder", "file-list"])
+def test_submit_with_the_real_plan(daemon, scan_folder, listed):
+    pytest.importorskip("boicp._boicp", reason="boicp._boicp is not built")
+    scans = sorted((scan_folder / "velodyne").glob("*.bin")) if listed else scan_folder
     with Client(daemon.address) as c:
-        job_id = c.submit(scan_folder, config="A", random_samples=4, iterations=4, seed=3,
+        job_id = c.submit(scans, config="A", random_samples=4, iterations=4, seed=3,
                           resolution=0.3)
-        assert watch_to_end(c, job_id)[-1].job.state == pb.JOB_STATE_SUCCEEDED, daemon.log()
+        events = watch_to_end(c, job_id)
+        assert events[-1].job.state == pb.JOB_STATE_SUCCEEDED, daemon.log()
         results = c.results(job_id)
+    assert events[-1].job.label == str(scan_folder / "velodyne" if listed else scan_folder)
     assert [(p.source, p.target) for p in results.pairs] == [(0, 1)]
     assert len(results.trajectory) == 2
+    assert results.pairs[0].transform.m[3] == pytest.approx(-SHIFT_X, abs=0.05)
+
+
+def test_submit_names_a_bad_setting_before_any_upload(daemon, scan_folder):
+    pytest.importorskip("boicp._boicp", reason="boicp._boicp is not built")
+    with Client(daemon.address) as c:
+        with pytest.raises(ValueError, match="unknown setting 'voxle'"):
+            c.submit(scan_folder, voxle=0.1)
+        with pytest.raises(ValueError, match="does not take 'icp_iterations'"):
+            c.submit(scan_folder, icp_iterations=3)

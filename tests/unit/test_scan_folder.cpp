@@ -327,6 +327,50 @@ TEST_F(ScanFolderTest, CloudFilesInNameOrderAndMixedFormatsRefused) {
               HasSubstr("mixes point formats (.ply, .xyz)"));
 }
 
+TEST_F(ScanFolderTest, AListOfFilesKeepsItsOrderAndFormatsAndSelects) {
+  WriteText(root_ / "b.xyz", "1 2 3\n");
+  WriteBin(root_ / "a.bin", 5);
+  WriteText(root_ / "c.xyz", "1 2 3\n");
+  const std::vector<std::string> files = {(root_ / "b.xyz").string(), (root_ / "a.bin").string(),
+                                          (root_ / "c.xyz").string()};
+  const ScanFolder listed = ReadScanList(files);
+  EXPECT_EQ(listed.layout, ScanLayout::kCloudFiles);
+  ASSERT_EQ(listed.scans.size(), 3u);
+  EXPECT_EQ(listed.scans[0].path, files[0]);
+  EXPECT_EQ(listed.scans[1].load.format, CloudFormat::kKittiBin);
+  EXPECT_EQ(listed.scans[2].load.format, CloudFormat::kXyz);
+  EXPECT_EQ(listed.reference_poses.size(), 3u);
+  EXPECT_THAT(listed.description, HasSubstr("3 of 3 scans (*.bin, *.xyz)"));
+
+  ScanFolderOptions every_other;
+  every_other.stride = 2;
+  const ScanFolder selected = ReadScanList(files, every_other);
+  ASSERT_EQ(selected.scans.size(), 2u);
+  EXPECT_EQ(selected.scans[1].path, files[2]);
+}
+
+TEST_F(ScanFolderTest, AListNamesItsMissingFileAndADepthImageWithoutItsCamera) {
+  WriteText(root_ / "a.xyz", "1 2 3\n");
+  WriteText(root_ / "d.png", "not read here");
+  const std::string present = (root_ / "a.xyz").string();
+  EXPECT_THAT(InputErrorMessage([&] {
+                ReadScanList({present, (root_ / "gone.xyz").string()});
+              }),
+              HasSubstr("gone.xyz: no such file"));
+  EXPECT_THAT(InputErrorMessage([&] {
+                ReadScanList({present, (root_ / "d.png").string()});
+              }),
+              HasSubstr("d.png: a depth image needs the intrinsics and the depth scale"));
+  EXPECT_THAT(InputErrorMessage([&] { ReadScanList({}); }), HasSubstr("empty"));
+
+  ScanFolderOptions camera;
+  camera.intrinsics = Intrinsics{500.0, 500.0, 320.0, 240.0};
+  camera.depth_scale = 1000.0;
+  const ScanFolder depth = ReadScanList({(root_ / "d.png").string()}, camera);
+  EXPECT_EQ(depth.scans[0].load.format, CloudFormat::kDepthPng);
+  EXPECT_EQ(depth.scans[0].load.depth.depth_scale, 1000.0);
+}
+
 TEST_F(ScanFolderTest, MissingOrUnrecognisableFolders) {
   EXPECT_THAT(InputErrorMessage([&] { ReadScanFolder((root_ / "none").string()); }),
               HasSubstr("none: no such folder"));

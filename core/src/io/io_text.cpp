@@ -65,23 +65,6 @@ Transform TransformFromNumbers(const std::string& path, const std::vector<double
   return T;
 }
 
-void RequireRigid(const std::string& path, const Transform& T) {
-  const Eigen::Vector4d bottom = T.row(3).transpose();
-  if ((bottom - Eigen::Vector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > kBottomRowTolerance) {
-    throw InputError(path + ": last row of a 4x4 transform must be 0 0 0 1");
-  }
-  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (error > kOrthonormalTolerance) {
-    throw InputError(path + ": rotation part is not orthonormal (max |R^T R - I| = " +
-                     std::to_string(error) + ", tolerance 1e-3)");
-  }
-  // An orthonormal matrix with determinant -1 is a reflection, not a motion.
-  if (R.determinant() < 0.0) {
-    throw InputError(path + ": rotation part is a reflection (determinant -1)");
-  }
-}
-
 // Shortest text that reads back as exactly the same double.
 void AppendNumber(double value, std::string* out) {
   char buffer[32];
@@ -124,8 +107,26 @@ Points ReadXyzText(const std::string& path, uint64_t max_points) {
 
 Transform ReadTransformFile(const std::string& path) {
   const Transform T = io_detail::TransformFromNumbers(path, io_detail::ReadNumbersFile(path));
-  io_detail::RequireRigid(path, T);
+  RequireRigidTransform(path, T);
   return T;
+}
+
+void RequireRigidTransform(const std::string& path, const Transform& T) {
+  const Eigen::Vector4d bottom = T.row(3).transpose();
+  if ((bottom - Eigen::Vector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() >
+      io_detail::kBottomRowTolerance) {
+    throw InputError(path + ": last row of a 4x4 transform must be 0 0 0 1");
+  }
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (error > io_detail::kOrthonormalTolerance) {
+    throw InputError(path + ": rotation part is not orthonormal (max |R^T R - I| = " +
+                     std::to_string(error) + ", tolerance 1e-3)");
+  }
+  // An orthonormal matrix with determinant -1 is a reflection, not a motion.
+  if (R.determinant() < 0.0) {
+    throw InputError(path + ": rotation part is a reflection (determinant -1)");
+  }
 }
 
 void WriteXyz(const std::string& path, const Points& points) {

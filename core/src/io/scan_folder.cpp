@@ -378,6 +378,32 @@ std::string LayoutTitle(ScanLayout layout) {
   return "scans";
 }
 
+// The scans of a full listing of `where` that options' first, stride and
+// count select.
+ScanFolder Select(FullListing all, const ScanFolderOptions& options, const std::string& where,
+                  ScanLayout layout) {
+  ScanFolder folder;
+  folder.layout = layout;
+  const int total = static_cast<int>(all.scans.size());
+  if (options.first >= total) {
+    throw InputError("first: " + std::to_string(options.first) + " is beyond the " +
+                     std::to_string(total) + " scans of " + where);
+  }
+  for (int i = options.first; i < total; i += options.stride) {
+    if (options.count > 0 && static_cast<int>(folder.scans.size()) == options.count) break;
+    const size_t k = static_cast<size_t>(i);
+    ScanSource scan = std::move(all.scans[k]);
+    const std::optional<Transform> pose =
+        all.reference_poses.empty() ? std::nullopt : all.reference_poses[k];
+    if (options.poses_as_priors) scan.prior_pose = pose;
+    folder.scans.push_back(std::move(scan));
+    folder.reference_poses.push_back(pose);
+  }
+  folder.description = LayoutTitle(folder.layout) + ", " + std::to_string(folder.scans.size()) +
+                       " of " + std::to_string(total) + " scans (" + all.what + ")";
+  return folder;
+}
+
 }  // namespace
 
 ScanLayout ParseScanLayout(const std::string& name) {
@@ -413,10 +439,10 @@ ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& opti
   if (!fs::exists(root, ec)) throw InputError(path + ": no such folder");
   if (!IsDirectory(root)) throw InputError(path + ": is not a folder");
 
-  ScanFolder folder;
-  folder.layout = options.layout == ScanLayout::kAuto ? DetectLayout(root) : options.layout;
+  const ScanLayout layout =
+      options.layout == ScanLayout::kAuto ? DetectLayout(root) : options.layout;
   FullListing all;
-  switch (folder.layout) {
+  switch (layout) {
     case ScanLayout::kKitti:
       all = ListKitti(root);
       break;
@@ -432,24 +458,31 @@ ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& opti
       break;
   }
 
-  const int total = static_cast<int>(all.scans.size());
-  if (options.first >= total) {
-    throw InputError("first: " + std::to_string(options.first) + " is beyond the " +
-                     std::to_string(total) + " scans of " + path);
+  return Select(std::move(all), options, path, layout);
+}
+
+ScanFolder ReadScanList(const std::vector<std::string>& paths, const ScanFolderOptions& options) {
+  ValidateSelection(options);
+  if (paths.empty()) throw InputError("the list of scans is empty");
+  FullListing all;
+  std::set<std::string> extensions;
+  for (const std::string& path : paths) {
+    if (!IsFile(path)) throw InputError(path + ": no such file");
+    ScanSource scan;
+    scan.path = path;
+    scan.load.format = DetectCloudFormat(path);
+    if (scan.load.format == CloudFormat::kDepthPng) {
+      if (!options.intrinsics || !(options.depth_scale > 0.0)) {
+        throw InputError(path + ": a depth image needs the intrinsics and the depth scale");
+      }
+      scan.load.depth.intrinsics = options.intrinsics;
+      scan.load.depth.depth_scale = options.depth_scale;
+    }
+    extensions.insert(Lower(fs::path(path).extension().string()));
+    all.scans.push_back(std::move(scan));
   }
-  for (int i = options.first; i < total; i += options.stride) {
-    if (options.count > 0 && static_cast<int>(folder.scans.size()) == options.count) break;
-    const size_t k = static_cast<size_t>(i);
-    ScanSource scan = all.scans[k];
-    const std::optional<Transform> pose =
-        all.reference_poses.empty() ? std::nullopt : all.reference_poses[k];
-    if (options.poses_as_priors) scan.prior_pose = pose;
-    folder.scans.push_back(std::move(scan));
-    folder.reference_poses.push_back(pose);
-  }
-  folder.description = LayoutTitle(folder.layout) + ", " + std::to_string(folder.scans.size()) +
-                       " of " + std::to_string(total) + " scans (" + all.what + ")";
-  return folder;
+  for (const std::string& ext : extensions) all.what += (all.what.empty() ? "*" : ", *") + ext;
+  return Select(std::move(all), options, "the list", ScanLayout::kCloudFiles);
 }
 
 void CheckScansLoad(const std::vector<ScanSource>& scans, int threads) {

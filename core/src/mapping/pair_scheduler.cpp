@@ -82,6 +82,7 @@ class PairScheduler {
     RegisteredPairs registered;
     registered.finished = std::move(finished_);
     registered.chain = planner_ ? planner_->ChainPairs() : plan_.chain;
+    registered.reused = reused_;
     return registered;
   }
 
@@ -113,6 +114,7 @@ class PairScheduler {
       if (finished_.count(pair) == 0) extras_queue_.push_back(pair);
     }
     next_order_ = static_cast<int>(finished_.size());
+    reused_ = static_cast<int>(finished_.size());
 
     // Reused pairs in listing order, so a rerun reports them as the first run did.
     std::vector<const PairResult*> reused;
@@ -300,6 +302,7 @@ class PairScheduler {
   std::set<int> probed_sources_;
   std::map<PairIndex, int> listing_order_;
   int next_order_ = 0;
+  int reused_ = 0;  // pairs loaded from the store
   std::exception_ptr failure_;
 
   std::atomic<bool> aborting_{false};

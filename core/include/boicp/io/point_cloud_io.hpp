@@ -107,6 +107,10 @@ LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options =
 /// rotation part is not orthonormal (tolerance 1e-3).
 Transform ReadTransformFile(const std::string& path);
 
+/// Throws InputError naming `what` unless T is a rigid motion: last row
+/// 0 0 0 1, rotation orthonormal (tolerance 1e-3), not a reflection.
+void RequireRigidTransform(const std::string& what, const Transform& T);
+
 /// Writes points as an ASCII XYZ file, one "x y z" line per point.
 void WriteXyz(const std::string& path, const Points& points);
 

@@ -52,6 +52,15 @@ struct ScanFolder {
 /// side file (poses, calib, times) is malformed. Scans are not loaded here.
 ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& options = {});
 
+/// The scans of a list of files, in the list's order, as ReadScanFolder
+/// gives a folder's (layout kCloudFiles; options' first, stride and count
+/// apply): each file's format from its extension, depth images with
+/// options' intrinsics and depth scale (both required). Throws InputError
+/// naming the file that is missing, of an unknown extension, or a depth
+/// image without intrinsics or depth scale, or for an empty list.
+ScanFolder ReadScanList(const std::vector<std::string>& paths,
+                        const ScanFolderOptions& options = {});
+
 /// Loads every scan once, on at most `threads` threads, and throws
 /// InputError naming the first one in their order that does not load
 /// (unreadable, truncated, no finite point). Run before uploading or

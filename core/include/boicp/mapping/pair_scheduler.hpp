@@ -33,6 +33,7 @@ struct PairExecution {
 struct RegisteredPairs {
   std::map<PairIndex, PairResult> finished;  // every finished pair the plan uses or probed
   std::vector<PairIndex> chain;              // the chain the poses are built from
+  int reused = 0;                            // of `finished`, those loaded from the store
 };
 
 /// Loads the store's finished pairs, then registers the rest of `plan` with
