@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job on a fresh machine: install dependencies, build everything,
-# start boicpd on a free loopback port with its data directory under build/,
-# submit a logged drive with the boicp client (a generated 8-scan drive, or
+# install the Python package, start boicpd on a free loopback port with its
+# data directory under build/, submit a logged drive with the boicp client (a generated 8-scan drive, or
 # the scans of --data DIR), follow its progress, export the map, trajectory
 # and preview, and stop the daemon.
 # Usage: bash deploy/demo.sh [--data DIR] [--out OUTDIR] [--preset A|B|C]
@@ -27,6 +27,12 @@ bash deploy/install-deps.sh
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
 cmake --build "$build" -j"$(nproc)"
 boicp="$build/bin/boicp"
+# The Python package, where Debian's python3 finds it: `python3 -c "import boicp"`.
+if [ -f "$build/python/boicp/__init__.py" ]; then
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  $sudo cmake --install "$build" --component python
+fi
 
 mkdir -p "$out"
 if [ -z "$data" ]; then

@@ -82,8 +82,10 @@ foreach(source ${_boicp_client_sources})
 endforeach()
 add_custom_target(boicp_python_client DEPENDS ${_boicp_generated} ${_boicp_client_copies})
 
-install(FILES ${_boicp_generated} DESTINATION "${BOICP_PYTHON_INSTALL_DIR}/boicp/v1")
-install(FILES ${_boicp_client_copies} DESTINATION "${BOICP_PYTHON_INSTALL_DIR}/boicp")
+install(FILES ${_boicp_generated} DESTINATION "${BOICP_PYTHON_INSTALL_DIR}/boicp/v1"
+        COMPONENT python)
+install(FILES ${_boicp_client_copies} DESTINATION "${BOICP_PYTHON_INSTALL_DIR}/boicp"
+        COMPONENT python)
 
 # `-p no:cacheprovider` and PYTHONDONTWRITEBYTECODE: the test file lives in
 # the source tree, and ctest writes nothing there. The tests skip (whole
