@@ -18,6 +18,7 @@ CommandRunner AddDemoDataCommand(CLI::App& app);
 CommandRunner AddMapCommand(CLI::App& app);
 CommandRunner AddPreviewCommand(CLI::App& app);
 CommandRunner AddMergeCommand(CLI::App& app);
+CommandRunner AddInfoCommand(CLI::App& app);
 
 #ifdef BOICP_WITH_REMOTE_COMMANDS
 // Talking to the daemon boicpd (built with it).

@@ -24,6 +24,9 @@ json ScanSettings(const ScanSource& scan) {
     out["depth_scale"] = d.depth_scale;
     out["invalid_values"] = d.invalid_values;
   }
+  if (const std::optional<BagMessageRef>& m = scan.load.bag_message) {
+    out["bag_message"] = {m->log_time_ns, m->position, m->offset, m->size};
+  }
   out["prior_pose"] = scan.prior_pose ? TransformToJson(*scan.prior_pose) : json(nullptr);
   return out;
 }

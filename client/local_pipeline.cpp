@@ -32,6 +32,7 @@ ScanFolderOptions FolderOptions(const MapSettings& s) {
   options.first = s.first;
   options.stride = s.stride;
   options.count = s.count;
+  options.bag = s.bag;
   return options;
 }
 
@@ -51,7 +52,12 @@ json MapSettingsToJson(const MapSettings& s) {
               {"intrinsics", s.intrinsics},
               {"camera", s.camera},
               {"depth_scale", s.depth_scale},
-              {"poses_as_priors", s.poses_as_priors}});
+              {"poses_as_priors", s.poses_as_priors},
+              {"topic", s.bag.topic},
+              {"odometry_topic", s.bag.odometry_topic},
+              {"start", s.bag.start},
+              {"duration", s.bag.duration},
+              {"min_interval", s.bag.min_interval}});
   return out;
 }
 
@@ -73,6 +79,12 @@ MapSettings MapSettingsFromJson(const json& j, const std::string& source) {
     s.camera = j.at("camera").get<std::string>();
     s.depth_scale = j.at("depth_scale").get<double>();
     s.poses_as_priors = j.at("poses_as_priors").get<bool>();
+    // Runs written before bags were read had none of these.
+    s.bag.topic = j.value("topic", std::string());
+    s.bag.odometry_topic = j.value("odometry_topic", std::string());
+    s.bag.start = j.value("start", 0.0);
+    s.bag.duration = j.value("duration", 0.0);
+    s.bag.min_interval = j.value("min_interval", 0.0);
     return s;
   } catch (const json::exception& e) {
     throw InputError(source + ": bad run settings (" + e.what() + ")");

@@ -25,7 +25,7 @@ namespace boicp::cli {
 /// map settings are the schema's (boicp/settings/setting_schema.hpp); the
 /// rest say which scans to read and how to pair them.
 struct MapSettings : settings::RequestedSettings {
-  std::string path;  // scan folder (made absolute)
+  std::string path;  // scan folder or bag (made absolute)
   std::string layout = "auto";
   std::string pairing = "consecutive";  // PairingModeName: consecutive | overlap | explicit
   std::string pairs_file;               // explicit pairing: "source,target" lines
@@ -36,6 +36,7 @@ struct MapSettings : settings::RequestedSettings {
   std::string camera;      // TUM fr1|fr2|fr3
   double depth_scale = 0.0;
   bool poses_as_priors = false;
+  BagScanSelection bag;  // when path is a bag
 };
 
 nlohmann::json MapSettingsToJson(const MapSettings& settings);

@@ -16,15 +16,18 @@ int main(int argc, char** argv) {
   add(reg, boicp::cli::AddRegisterCommand(*reg));
   CLI::App* demo = app.add_subcommand("demo-data", "Write a generated demo pair or sequence");
   add(demo, boicp::cli::AddDemoDataCommand(*demo));
-  CLI::App* map = app.add_subcommand("map", "Build a map from a scan folder locally (no daemon)");
+  CLI::App* map =
+      app.add_subcommand("map", "Build a map from a scan folder or bag locally (no daemon)");
   add(map, boicp::cli::AddMapCommand(*map));
   CLI::App* preview = app.add_subcommand("preview", "Draw a top-down PNG of an OctoMap");
   add(preview, boicp::cli::AddPreviewCommand(*preview));
   CLI::App* merge = app.add_subcommand("merge", "Build the map of a sharded `map` run");
   add(merge, boicp::cli::AddMergeCommand(*merge));
+  CLI::App* info = app.add_subcommand("info", "List a bag's topics, types, counts and duration");
+  add(info, boicp::cli::AddInfoCommand(*info));
 #ifdef BOICP_WITH_REMOTE_COMMANDS  // talking to boicpd
   CLI::App* submit =
-      app.add_subcommand("submit", "Upload a scan folder and submit a job to boicpd");
+      app.add_subcommand("submit", "Upload a scan folder or bag and submit a job to boicpd");
   add(submit, boicp::cli::AddSubmitCommand(*submit));
   CLI::App* watch = app.add_subcommand("watch", "Follow a job to its end (exit 0 if it succeeded)");
   add(watch, boicp::cli::AddWatchCommand(*watch));

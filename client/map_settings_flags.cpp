@@ -3,6 +3,24 @@
 #include "boicp/util/system_memory.hpp"
 
 namespace boicp::cli {
+namespace {
+
+void AddBagFlags(CLI::App& app, BagScanSelection& bag) {
+  app.add_option("--topic", bag.topic,
+                 "Bag: the PointCloud2 topic of the scans (default: the bag's only one)");
+  app.add_option("--odometry-topic", bag.odometry_topic,
+                 "Bag: an Odometry or PoseStamped topic whose pose at each scan's stamp is its "
+                 "prior");
+  app.add_option("--start", bag.start, "Bag: seconds after its first message to start at")
+      ->capture_default_str();
+  app.add_option("--duration", bag.duration, "Bag: seconds of scans kept; 0 = to the end")
+      ->capture_default_str();
+  app.add_option("--min-interval", bag.min_interval,
+                 "Bag: seconds at least between kept scans (instead of --every)")
+      ->capture_default_str();
+}
+
+}  // namespace
 
 void AddFusionLimitFlag(CLI::App& app, uint64_t& max_fusion_mb) {
   max_fusion_mb = DefaultFusionLimitMb();
@@ -16,8 +34,11 @@ void AddFusionLimitFlag(CLI::App& app, uint64_t& max_fusion_mb) {
 void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Frontend frontend) {
   MapSettings& s = flags.settings;
   flags.frontend = frontend;
-  app.add_option("PATH", s.path, "Scan folder (KITTI, TUM, 7-Scenes, or .pcd/.ply/.xyz files)");
-  app.add_option("--layout", s.layout, "auto, kitti, tum, 7scenes or files")->capture_default_str();
+  app.add_option("PATH", s.path,
+                 "Scan folder (KITTI, TUM, 7-Scenes, or .pcd/.ply/.xyz files) or bag (ROS 1 "
+                 ".bag, ROS 2 .mcap, .db3 or bag folder)");
+  app.add_option("--layout", s.layout, "auto, kitti, tum, 7scenes, files or bag")
+      ->capture_default_str();
   app.add_option("--pairing", flags.pairing_words,
                  "consecutive, overlap (keyframes by overlap) or explicit FILE (lines of "
                  "'source,target' scan indices)")
@@ -32,7 +53,7 @@ void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Front
                  "registered besides (loop closures, weighed in a pose graph)");
   settings::AddSettingFlags(app, frontend, s, flags.setting_texts);
   app.add_option("--first", s.first, "Index of the first scan kept")->capture_default_str();
-  app.add_option("--stride", s.stride, "Keep every N-th scan")->capture_default_str();
+  app.add_option("--stride,--every", s.stride, "Keep every N-th scan")->capture_default_str();
   app.add_option("--count", s.count, "At most N scans; 0 = all")->capture_default_str();
   app.add_option("--intrinsics", s.intrinsics, "Depth camera fx,fy,cx,cy (pixels)");
   app.add_option("--depth-scale", s.depth_scale,
@@ -40,6 +61,7 @@ void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Front
   app.add_option("--camera", s.camera, "TUM camera fr1, fr2 or fr3");
   app.add_flag("--poses-as-priors", s.poses_as_priors,
                "Use the folder's poses (KITTI poses.txt, 7-Scenes) as search priors");
+  AddBagFlags(app, s.bag);
 }
 
 MapSettings ResolveMapSettings(const MapSettingsFlags& flags) {
@@ -58,6 +80,9 @@ MapSettings ResolveMapSettings(const MapSettingsFlags& flags) {
     s.path = words[used];
   }
   if (s.path.empty()) throw InputError("PATH: the folder of scans is required");
+  if (s.stride != 1 && s.bag.min_interval > 0.0) {
+    throw InputError("--every and --min-interval: give one of them");
+  }
   return s;
 }
 

@@ -1,4 +1,4 @@
-// `boicp submit PATH`: reads a folder of scans, checks that every scan
+// `boicp submit PATH`: reads a folder of scans or a bag, checks that every scan
 // loads, uploads what the daemon lacks, submits one batch and prints its
 // job id alone on stdout (with --wait, then follows it like watch).
 
@@ -41,7 +41,7 @@ std::vector<std::string> UploadScans(rpc::MapBuilderClient& client,
   int already = 0;
   const size_t n = scans.size();
   for (size_t i = 0; i < n; ++i) {
-    const v1::UploadScanResponse response = client.UploadFile(scans[i].path, metadata[i]);
+    const v1::UploadScanResponse response = client.UploadScan(scans[i], metadata[i]);
     ids.push_back(response.scan_id());
     if (response.already_present()) {
       ++already;

@@ -113,7 +113,7 @@ def read_scan(path, format="auto", *, intrinsics=None, intrinsics_file="", depth
 
 
 def build_map(folder, out_dir, *, progress=None, threads=0, max_fusion_mb=0, **settings):
-    """Builds the map of a folder of scans, as ``boicp map FOLDER -o OUT_DIR`` does.
+    """Builds the map of a folder of scans or a bag, as ``boicp map FOLDER -o OUT_DIR`` does.
 
     Writes map.bt, map.ot, trajectory.tum, trajectory.kitti, pairs.json,
     preview.png, run.json and pairs/ into out_dir; a second run reuses the
@@ -130,7 +130,9 @@ def build_map(folder, out_dir, *, progress=None, threads=0, max_fusion_mb=0, **s
     settings: the map's settings by name (config, voxel, resolution,
         max_range, ...) and run.json's folder and pairing keys (layout,
         first, stride, count, pairing, pairs_file, overlap_threshold,
-        extra_pairs_file, intrinsics, camera, depth_scale, poses_as_priors).
+        extra_pairs_file, intrinsics, camera, depth_scale, poses_as_priors)
+        and, for a bag, topic, odometry_topic, start, duration and
+        min_interval.
     """
     return _boicp.build_map(str(folder), str(out_dir), settings, int(threads),
                             int(max_fusion_mb), progress)

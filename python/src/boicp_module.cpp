@@ -156,6 +156,11 @@ py::dict PlanSubmission(const py::object& scans, const py::dict& settings) {
                         settings::kSubmit, "boicp.client.submit");
   const cli::LocalRun run =
       folder ? cli::PrepareRun(map_settings) : cli::PrepareRun(map_settings, files);
+  if (run.layout == ScanLayout::kBag) {
+    throw InputError(run.settings.path +
+                     ": boicp.client.submit uploads scan files; submit a bag with `boicp submit "
+                     "BAG`");
+  }
   {
     py::gil_scoped_release release;
     CheckScansLoad(run.batch.scans, AvailableCores());

@@ -5,6 +5,7 @@
 #include <tuple>
 #include <utility>
 
+#include "boicp/io/point_cloud_io.hpp"
 #include "boicp/rpc/sha256.hpp"
 
 namespace boicp::rpc {
@@ -105,6 +106,12 @@ v1::UploadScanResponse MapBuilderClient::Upload(const std::string& bytes, v1::Sc
 v1::UploadScanResponse MapBuilderClient::UploadFile(const std::string& path,
                                                     const v1::ScanMetadata& metadata) {
   return Upload(ReadAll(path), metadata);
+}
+
+v1::UploadScanResponse MapBuilderClient::UploadScan(const ScanSource& scan,
+                                                    const v1::ScanMetadata& metadata) {
+  if (scan.load.format != CloudFormat::kRosMessage) return UploadFile(scan.path, metadata);
+  return Upload(EncodeBinaryPcd(LoadPointCloud(scan.path, scan.load).points), metadata);
 }
 
 v1::Job MapBuilderClient::Submit(const v1::SubmitBatchRequest& request) {

@@ -120,8 +120,10 @@ LoadOptions LoadOptionsFromMetadata(const v1::ScanMetadata& metadata) {
 }
 
 v1::ScanMetadata ScanMetadataOf(const ScanSource& scan) {
-  const CloudFormat format =
+  CloudFormat format =
       scan.load.format == CloudFormat::kAuto ? DetectCloudFormat(scan.path) : scan.load.format;
+  // A scan inside a bag travels as the binary PCD of its points (MapBuilderClient::UploadScan).
+  if (format == CloudFormat::kRosMessage) format = CloudFormat::kPcd;
   v1::ScanMetadata metadata;
   metadata.set_format(ScanFormatOf(format));
   if (format == CloudFormat::kDepthPng) {

@@ -25,7 +25,8 @@ while [ $# -gt 0 ]; do
 done
 case "$seconds" in '' | *[!0-9]*) echo "run.sh: --seconds needs a whole number" >&2; exit 2 ;; esac
 
-names=(fuzz_kitti fuzz_pcd fuzz_ply fuzz_xyz fuzz_depth_png fuzz_request)
+names=(fuzz_kitti fuzz_pcd fuzz_ply fuzz_xyz fuzz_depth_png fuzz_ros1_bag fuzz_ros2_db3 fuzz_mcap
+  fuzz_ros_messages fuzz_request)
 if [ ${#only[@]} -gt 0 ]; then names=("${only[@]}"); fi
 
 logs="$build/fuzz-logs"

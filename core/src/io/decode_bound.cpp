@@ -81,6 +81,8 @@ uint64_t DecodeBoundBytes(const std::string& path, const LoadOptions& options) {
       return XyzBound(path, limit);
     case CloudFormat::kDepthPng:
       return DepthPngBound(path, limit);
+    case CloudFormat::kRosMessage:
+      return io_detail::RosMessageBound(path, options);
     case CloudFormat::kAuto:
       break;
   }

@@ -9,6 +9,7 @@
 // would mean changing global state.
 
 #include <algorithm>
+#include <cstring>
 #include <map>
 #include <optional>
 #include <string_view>
@@ -163,3 +164,25 @@ Points ReadPcdOrPly(const std::string& path, CloudFormat format, uint64_t max_po
 }
 
 }  // namespace boicp::io_detail
+
+namespace boicp {
+
+std::string EncodeBinaryPcd(const Points& points) {
+  const std::string n = std::to_string(points.size());
+  std::string bytes =
+      "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\n"
+      "TYPE F F F\nCOUNT 1 1 1\nWIDTH " +
+      n + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + n + "\nDATA binary\n";
+  size_t at = bytes.size();
+  bytes.resize(at + points.size() * 3 * sizeof(float));
+  // The hosts boicp runs on are little-endian, as PCD's binary data is.
+  for (const Point& p : points) {
+    const float xyz[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()),
+                          static_cast<float>(p.z())};
+    std::memcpy(&bytes[at], xyz, sizeof xyz);
+    at += sizeof xyz;
+  }
+  return bytes;
+}
+
+}  // namespace boicp

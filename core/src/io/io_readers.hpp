@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
+#include "boicp/io/scan_folder.hpp"
 
 namespace boicp::io_detail {
 
@@ -99,5 +100,23 @@ Points ReadKittiBin(const std::string& path, uint64_t max_points);
 Points ReadPcdOrPly(const std::string& path, CloudFormat format, uint64_t max_points);
 Points ReadXyzText(const std::string& path, uint64_t max_points);
 Points ReadDepthPng(const std::string& path, const DepthOptions& options, uint64_t max_points);
+
+/// Every scan of a folder or bag, before first, stride and count select some.
+struct FullListing {
+  std::vector<ScanSource> scans;
+  std::vector<std::optional<Transform>> reference_poses;  // empty or one per scan
+  std::string what;                                       // e.g. "velodyne/*.bin"
+};
+
+/// The scans of a bag (IsBagPath) that `selection` picks, with its odometry
+/// as reference poses. Reads every kept message's header stamp.
+FullListing ListBagScans(const std::string& path, const BagScanSelection& selection);
+
+/// The PointCloud2 at options.bag_message in the bag file `path`.
+Points ReadRosMessage(const std::string& path, const LoadOptions& options);
+
+/// What ReadRosMessage allocates at most: the message, the chunk it is
+/// read from (at most as large again) and its points.
+uint64_t RosMessageBound(const std::string& path, const LoadOptions& options);
 
 }  // namespace boicp::io_detail

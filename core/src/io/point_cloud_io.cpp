@@ -33,6 +33,8 @@ Points ReadPoints(const std::string& path, CloudFormat format, const LoadOptions
       return io_detail::ReadXyzText(path, limit);
     case CloudFormat::kDepthPng:
       return io_detail::ReadDepthPng(path, options.depth, limit);
+    case CloudFormat::kRosMessage:
+      return io_detail::ReadRosMessage(path, options);
     case CloudFormat::kAuto:
       break;
   }
@@ -90,6 +92,8 @@ std::string CloudFormatName(CloudFormat format) {
       return "xyz";
     case CloudFormat::kDepthPng:
       return "depth";
+    case CloudFormat::kRosMessage:
+      return "ros";
   }
   return "unknown";
 }

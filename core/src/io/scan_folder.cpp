@@ -17,6 +17,7 @@ namespace boicp {
 namespace {
 
 namespace fs = std::filesystem;
+using io_detail::FullListing;
 using io_detail::IsBlankOrComment;
 using io_detail::ParseNumber;
 using io_detail::SplitFields;
@@ -159,12 +160,6 @@ std::vector<std::vector<double>> ReadTable(const fs::path& path, size_t width, s
   }
   return rows;
 }
-
-struct FullListing {
-  std::vector<ScanSource> scans;
-  std::vector<std::optional<Transform>> reference_poses;  // empty or one per scan
-  std::string what;                                       // e.g. "velodyne/*.bin"
-};
 
 FullListing ListKitti(const fs::path& root) {
   FullListing out;
@@ -372,6 +367,8 @@ std::string LayoutTitle(ScanLayout layout) {
       return "7-Scenes sequence";
     case ScanLayout::kCloudFiles:
       return "point-cloud files";
+    case ScanLayout::kBag:
+      return "bag";
     case ScanLayout::kAuto:
       break;
   }
@@ -413,7 +410,8 @@ ScanLayout ParseScanLayout(const std::string& name) {
   if (n == "tum") return ScanLayout::kTum;
   if (n == "7scenes") return ScanLayout::kSevenScenes;
   if (n == "files") return ScanLayout::kCloudFiles;
-  throw InputError("layout: '" + name + "' is not auto, kitti, tum, 7scenes or files");
+  if (n == "bag") return ScanLayout::kBag;
+  throw InputError("layout: '" + name + "' is not auto, kitti, tum, 7scenes, files or bag");
 }
 
 std::string ScanLayoutName(ScanLayout layout) {
@@ -428,12 +426,25 @@ std::string ScanLayoutName(ScanLayout layout) {
       return "7scenes";
     case ScanLayout::kCloudFiles:
       return "files";
+    case ScanLayout::kBag:
+      return "bag";
   }
   return "auto";
 }
 
 ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& options) {
   ValidateSelection(options);
+  if (options.layout == ScanLayout::kBag ||
+      (options.layout == ScanLayout::kAuto && IsBagPath(path))) {
+    ScanFolderOptions bag_options = options;
+    bag_options.poses_as_priors |= !options.bag.odometry_topic.empty();
+    return Select(io_detail::ListBagScans(path, options.bag), bag_options, path, ScanLayout::kBag);
+  }
+  if (options.bag.Any()) {
+    throw InputError(path +
+                     ": bag options (topic, odometry topic, start, duration, min "
+                     "interval) need a bag (.bag, .db3, .mcap or a ROS 2 bag folder)");
+  }
   const fs::path root(path);
   std::error_code ec;
   if (!fs::exists(root, ec)) throw InputError(path + ": no such folder");
@@ -454,6 +465,7 @@ ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& opti
       break;
     case ScanLayout::kCloudFiles:
     case ScanLayout::kAuto:
+    case ScanLayout::kBag:
       all = ListCloudFiles(root);
       break;
   }

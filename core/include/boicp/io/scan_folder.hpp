@@ -1,20 +1,22 @@
 #pragma once
-// Reading a logged drive from a folder: the layout (KITTI odometry, TUM
-// RGB-D, 7-Scenes, or a folder of PCD/PLY/XYZ files) is detected from the
-// files present, or forced, and turned into the batch's scan list.
+// Reading a logged drive from a folder or a bag: the layout (KITTI odometry,
+// TUM RGB-D, 7-Scenes, a folder of PCD/PLY/XYZ files, or a ROS 1 / ROS 2 bag)
+// is detected from the files present, or forced, and turned into the
+// batch's scan list.
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "boicp/io/bag_scans.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/scan_source.hpp"
 
 namespace boicp {
 
-enum class ScanLayout { kAuto, kKitti, kTum, kSevenScenes, kCloudFiles };
+enum class ScanLayout { kAuto, kKitti, kTum, kSevenScenes, kCloudFiles, kBag };
 
-/// Parses "auto", "kitti", "tum", "7scenes", "files". Throws InputError otherwise.
+/// Parses "auto", "kitti", "tum", "7scenes", "files", "bag". Throws InputError otherwise.
 ScanLayout ParseScanLayout(const std::string& name);
 std::string ScanLayoutName(ScanLayout layout);
 
@@ -35,6 +37,9 @@ struct ScanFolderOptions {
   int first = 0;   // index of the first scan kept (in name / time order)
   int stride = 1;  // keep every stride-th scan, >= 1
   int count = 0;   // at most this many scans; 0 = all
+  /// Bags only: the topics and the time window (applied before first,
+  /// stride and count). An odometry topic turns poses_as_priors on.
+  BagScanSelection bag;
 };
 
 struct ScanFolder {
@@ -46,10 +51,13 @@ struct ScanFolder {
   std::string description;  // one line, e.g. "KITTI sequence, 10 scans (velodyne/*.bin)"
 };
 
-/// Lists the scans of `path`. Throws InputError naming the file and the
-/// problem when the folder is missing or holds nothing recognisable, mixes
-/// point formats, lacks what its layout needs (intrinsics, depth.txt), or a
-/// side file (poses, calib, times) is malformed. Scans are not loaded here.
+/// Lists the scans of `path`, a folder or a bag (IsBagPath). Throws
+/// InputError naming the file and the problem when the folder is missing or
+/// holds nothing recognisable, mixes point formats, lacks what its layout
+/// needs (intrinsics, depth.txt), or a side file (poses, calib, times) is
+/// malformed; for a bag, when it is malformed, has no PointCloud2 topic or
+/// several and options.bag names none, or the window keeps no message.
+/// Scans are not loaded here; a bag's are read for their header stamps.
 ScanFolder ReadScanFolder(const std::string& path, const ScanFolderOptions& options = {});
 
 /// The scans of a list of files, in the list's order, as ReadScanFolder

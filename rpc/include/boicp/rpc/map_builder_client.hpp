@@ -12,6 +12,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include "boicp/io/scan_source.hpp"
 #include "boicp/v1/map_builder.grpc.pb.h"
 
 namespace boicp::rpc {
@@ -62,6 +63,10 @@ class MapBuilderClient {
                                 size_t chunk_bytes = 1 << 20);
   /// Reads the file and uploads it. Throws std::runtime_error when unreadable.
   v1::UploadScanResponse UploadFile(const std::string& path, const v1::ScanMetadata& metadata);
+  /// Uploads a scan (metadata from ScanMetadataOf): its file, or, for a scan
+  /// inside a bag, the binary PCD of its points. Throws InputError when the
+  /// scan does not load.
+  v1::UploadScanResponse UploadScan(const ScanSource& scan, const v1::ScanMetadata& metadata);
 
   v1::Job Submit(const v1::SubmitBatchRequest& request);
   v1::Job GetJob(const std::string& job_id);
