@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -62,7 +63,7 @@ class BagCli : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    MakeDrive(5);
+    MakeGeneratedDrive(5);
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -70,20 +71,49 @@ class BagCli : public ::testing::Test {
     return RunCaptured(std::string(BOICP_CLI_PATH) + " " + args, dir_);
   }
 
-  // A generated drive: a folder of PCD scans 2 m apart with a gentle turn,
-  // and as messages, the scans as the folder loads them at 10 Hz and
-  // odometry (the true poses, interpolated) at 20 Hz.
-  void MakeDrive(int n) {
+  // Scans 2 m apart with a gentle turn along the generated street.
+  void MakeGeneratedDrive(int n) {
     const Points world = MakeSyntheticStreet(11);
-    folder_ = dir_ / "scans";
-    fs::create_directories(folder_);
+    std::vector<Points> scans;
     std::vector<Transform> poses;
     for (int i = 0; i < n; ++i) {
       poses.push_back(PoseFromYawTranslation(0.04 * i, {-5.0 + 2.0 * i, 0.3 * i, 1.8}));
+      scans.push_back(SimulateScan(world, poses.back(), 30.0, 0.02, 100 + i));
+    }
+    MakeDrive(scans, poses);
+  }
+
+  // The first n scans of the shared KITTI sequence, with its poses; false
+  // when the data is absent.
+  bool MakeKittiDrive(int n) {
+    const fs::path kitti = fs::path(BOICP_SHARED_DATA_DIR) / "kitti00";
+    if (!fs::is_directory(kitti)) return false;
+    ScanFolderOptions options;
+    options.count = n;
+    const ScanFolder folder = ReadScanFolder(kitti.string(), options);
+    std::vector<Points> scans;
+    std::vector<Transform> poses;
+    for (size_t i = 0; i < folder.scans.size(); ++i) {
+      scans.push_back(LoadPointCloud(folder.scans[i].path, folder.scans[i].load).points);
+      poses.push_back(folder.reference_poses[i].value());
+    }
+    messages_.clear();
+    fs::remove_all(folder_);
+    MakeDrive(scans, poses);
+    return true;
+  }
+
+  // The drive as a folder of PCD scans, and as messages: the scans as the
+  // folder loads them at 10 Hz and odometry (the poses, interpolated) at 20 Hz.
+  void MakeDrive(const std::vector<Points>& scans, const std::vector<Transform>& poses) {
+    const int n = static_cast<int>(scans.size());
+    folder_ = dir_ / "scans";
+    fs::create_directories(folder_);
+    for (int i = 0; i < n; ++i) {
       char name[32];
       std::snprintf(name, sizeof name, "scan%03d.pcd", i);
       std::ofstream(folder_ / name, std::ios::binary)
-          << EncodeBinaryPcd(SimulateScan(world, poses.back(), 30.0, 0.02, 100 + i));
+          << EncodeBinaryPcd(scans[static_cast<size_t>(i)]);
       messages_.push_back({"/points", "sensor_msgs/PointCloud2", kFirstStamp + i * kScanPeriod,
                            LoadPointCloud((folder_ / name).string()).points,
                            Transform::Identity()});
@@ -135,12 +165,20 @@ class BagCli : public ::testing::Test {
     return contents;
   }
 
+  // `boicp map` on a ROS 1 bag (lz4 chunks), a ROS 2 .db3 folder (float64
+  // points) and a ROS 2 .mcap file (zstd chunks) of the drive gives the
+  // trajectory of the folder of its scans, byte for byte.
+  void ExpectEveryBagGivesTheFoldersTrajectory();
+
   fs::path dir_;
   fs::path folder_;  // the drive's scans as PCD files
   std::vector<DriveMessage> messages_;
 };
 
-TEST_F(BagCli, EveryKindOfBagGivesTheFoldersTrajectory) {
+void BagCli::ExpectEveryBagGivesTheFoldersTrajectory() {
+  const size_t n = static_cast<size_t>(
+      std::count_if(messages_.begin(), messages_.end(),
+                    [](const DriveMessage& m) { return m.topic == "/points"; }));
   const RunResult reference =
       Run("map " + folder_.string() + " -o " + (dir_ / "out-folder").string() + Quick());
   ASSERT_EQ(reference.exit_code, 0) << reference.err;
@@ -171,13 +209,23 @@ TEST_F(BagCli, EveryKindOfBagGivesTheFoldersTrajectory) {
     const fs::path out = dir_ / ("out-" + name);
     const RunResult r = Run("map " + bag.string() + " -o " + out.string() + Quick());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_THAT(r.err, HasSubstr("bag, 5 of 5 scans")) << r.err;
+    const std::string count = std::to_string(n);
+    EXPECT_THAT(r.err, HasSubstr("bag, " + count + " of " + count + " scans")) << r.err;
     EXPECT_EQ(Slurp(out / "trajectory.kitti"), trajectory);
     // The header stamps are the trajectory's timestamps.
     const std::vector<TimedPose> tum = ReadTumTrajectory((out / "trajectory.tum").string());
-    ASSERT_EQ(tum.size(), 5u);
+    ASSERT_EQ(tum.size(), n);
     EXPECT_NEAR(tum[3].timestamp, 1.7e9 + 0.3, 1e-6);
   }
+}
+
+TEST_F(BagCli, EveryKindOfBagGivesTheFoldersTrajectory) {
+  ExpectEveryBagGivesTheFoldersTrajectory();
+}
+
+TEST_F(BagCli, EveryKindOfBagOfRealKittiScansGivesTheFoldersTrajectory) {
+  if (!MakeKittiDrive(4)) GTEST_SKIP() << "no ../shared/data/kitti00";
+  ExpectEveryBagGivesTheFoldersTrajectory();
 }
 
 TEST_F(BagCli, OdometryGivesPriorsThatThePriorRungAnswers) {

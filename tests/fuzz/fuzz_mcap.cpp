@@ -1,57 +1,9 @@
-// libFuzzer harness: arbitrary bytes as a ROS 2 .mcap bag, read whole through
-// OpenBag (topics, time range, every topic's messages, every message's bytes).
+// libFuzzer harness: arbitrary bytes as a ROS 2 .mcap file, read whole
+// through OpenBag (ReadFuzzBag).
 
-#include <unistd.h>
-
-#include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <string>
-
-#include "boicp/io/bag_reader.hpp"
-#include "boicp/util/types.hpp"
-
-namespace {
-
-// A small limit, so inputs declaring big chunks are refused rather than
-// spending the run on allocating and zeroing them.
-constexpr uint64_t kFuzzMessageLimit = uint64_t{1} << 20;
-
-void ReadWholeBag(const std::string& path) {
-  boicp::BagLimits limits;
-  limits.max_message_bytes = kFuzzMessageLimit;
-  std::unique_ptr<boicp::BagReader> bag = boicp::OpenBag(path, limits);
-  bag->TimeRange();
-  for (const boicp::BagTopic& topic : bag->Topics()) {
-    for (const boicp::BagMessageRef& ref : bag->Messages(topic.name)) {
-      if (bag->Read(ref).size() != ref.size) {
-        std::fprintf(stderr, "Read returned another size than Messages declared\n");
-        std::abort();
-      }
-    }
-  }
-}
-
-}  // namespace
+#include "load_fuzz_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  // One file per process, overwritten by every input.
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            ("boicp-fuzz-" + std::to_string(::getpid()) + ".mcap"))
-                               .string();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-    if (!out) std::abort();
-  }
-  try {
-    ReadWholeBag(path);
-  } catch (const boicp::InputError&) {
-    // Malformed input refused with a message: the expected outcome.
-  }
-  std::error_code ignored;
-  std::filesystem::remove(path, ignored);
+  boicp::fuzz::ReadFuzzBag(data, size, ".mcap");
   return 0;
 }

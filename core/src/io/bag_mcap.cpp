@@ -23,6 +23,7 @@
 
 #include "bag_readers.hpp"
 #include "boicp/util/types.hpp"
+#include "bounded_file.hpp"
 #include "chunk_decompression.hpp"
 
 namespace boicp::io_detail {
@@ -87,12 +88,6 @@ struct Where {
   }
 };
 
-uint64_t LoadLittleEndian(const uint8_t* bytes, int size) {
-  uint64_t value = 0;
-  for (int i = size - 1; i >= 0; --i) value = (value << 8) | bytes[i];
-  return value;
-}
-
 // Reads a record body's little-endian fields in order, refusing to read past
 // its end.
 class Cursor {
@@ -130,39 +125,6 @@ class Cursor {
   uint64_t size_;
   uint64_t used_ = 0;
   Where where_;
-};
-
-// Random access to the file, every read checked against its size.
-class McapFile {
- public:
-  explicit McapFile(const std::string& path) : path_(path), in_(path, std::ios::binary) {
-    std::error_code error;
-    size_ = std::filesystem::file_size(path, error);
-    if (!in_ || error) throw InputError(path + ": cannot open for reading");
-  }
-
-  uint64_t size() const { return size_; }
-  bool Has(uint64_t at, uint64_t count) const { return at <= size_ && count <= size_ - at; }
-
-  // `count` bytes at `at`; the caller has checked them against the limits.
-  std::vector<uint8_t> ReadAt(uint64_t at, uint64_t count) {
-    if (!Has(at, count)) {
-      throw InputError(path_ + ": truncated: " + std::to_string(count) + " bytes at byte " +
-                       std::to_string(at) + " run past the end of the file (" +
-                       std::to_string(size_) + " bytes)");
-    }
-    std::vector<uint8_t> bytes(count);
-    in_.clear();
-    in_.seekg(static_cast<std::streamoff>(at));
-    in_.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
-    if (!in_) throw InputError(path_ + ": read error at byte " + std::to_string(at));
-    return bytes;
-  }
-
- private:
-  std::string path_;
-  std::ifstream in_;
-  uint64_t size_ = 0;
 };
 
 struct McapSchema {
@@ -753,7 +715,7 @@ class McapBag final : public BagReader {
 
   std::string path_;
   BagLimits limits_;
-  McapFile file_;
+  BoundedFile file_;
   std::optional<Summary> summary_;
   std::optional<FullScan> scan_;
   uint64_t cached_chunk_at_ = kUnchunked;

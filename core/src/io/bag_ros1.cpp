@@ -33,6 +33,7 @@
 
 #include "bag_readers.hpp"
 #include "boicp/util/types.hpp"
+#include "bounded_file.hpp"
 #include "chunk_decompression.hpp"
 
 namespace boicp::io_detail {
@@ -59,61 +60,41 @@ constexpr uint64_t kRecordLengths = 8;
 
 using Fields = std::map<std::string, std::string>;
 
-/// A bag file read by explicit ranges, every range checked against its size.
+/// A bag file read by explicit ranges, every range checked against the
+/// file's size and the message limit.
 class BagFile {
  public:
-  BagFile(const std::string& path, const BagLimits& limits) : path_(path), limits_(limits) {
-    in_.open(path, std::ios::binary);
-    if (!in_) Fail("cannot open the file");
-    in_.seekg(0, std::ios::end);
-    const std::streamoff end = in_.tellg();
-    if (end < 0) Fail("cannot read the file's size");
-    size_ = static_cast<uint64_t>(end);
-  }
+  BagFile(const std::string& path, const BagLimits& limits) : file_(path), limits_(limits) {}
 
-  uint64_t size() const { return size_; }
+  uint64_t size() const { return file_.size(); }
   const BagLimits& limits() const { return limits_; }
 
   [[noreturn]] void Fail(const std::string& problem) const {
-    throw InputError(path_ + ": " + problem);
+    throw InputError(file_.path() + ": " + problem);
   }
 
   /// `n` bytes at `at`: refused when past the end of the file or over the
   /// message limit, so nothing is allocated from a size the file made up.
   std::vector<uint8_t> Read(uint64_t at, uint64_t n, const char* what) {
-    if (at > size_ || n > size_ - at) {
+    if (!file_.Has(at, n)) {
       Fail(std::string("truncated ") + what + " at byte " + std::to_string(at) + " (" +
-           std::to_string(n) + " bytes past the end of the " + std::to_string(size_) +
+           std::to_string(n) + " bytes past the end of the " + std::to_string(size()) +
            "-byte file)");
     }
     if (n > limits_.max_message_bytes) {
       Fail(std::string(what) + " at byte " + std::to_string(at) + " declares " + std::to_string(n) +
            " bytes, over the limit of " + std::to_string(limits_.max_message_bytes));
     }
-    std::vector<uint8_t> bytes(n);
-    in_.clear();
-    in_.seekg(static_cast<std::streamoff>(at));
-    in_.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(n));
-    if (!in_) Fail(std::string("cannot read ") + what + " at byte " + std::to_string(at));
-    return bytes;
+    return file_.ReadAt(at, n);
   }
 
   uint32_t U32(uint64_t at, const char* what) {
-    const std::vector<uint8_t> bytes = Read(at, 4, what);
-    return LittleEndian(bytes.data(), 4);
-  }
-
-  static uint64_t LittleEndian(const uint8_t* p, size_t n) {
-    uint64_t value = 0;
-    for (size_t i = 0; i < n; ++i) value |= uint64_t{p[i]} << (8 * i);
-    return value;
+    return static_cast<uint32_t>(LoadLittleEndian(Read(at, 4, what).data(), 4));
   }
 
  private:
-  std::string path_;
+  BoundedFile file_;
   BagLimits limits_;
-  std::ifstream in_;
-  uint64_t size_ = 0;
 };
 
 // A record header's fields, each a uint32 length then "name=value", checked
@@ -124,7 +105,7 @@ Fields ParseFields(BagFile& file, const uint8_t* p, uint64_t n, uint64_t at, con
   while (used < n) {
     if (n - used < 4)
       file.Fail(std::string("malformed ") + what + " header at byte " + std::to_string(at));
-    const uint64_t length = BagFile::LittleEndian(p + used, 4);
+    const uint64_t length = LoadLittleEndian(p + used, 4);
     used += 4;
     if (length > n - used || length > kMaxHeaderField) {
       file.Fail(std::string("malformed ") + what + " header at byte " + std::to_string(at) +
@@ -172,7 +153,7 @@ uint64_t UnsignedField(BagFile& file, const Fields& fields, const char* name, si
     file.Fail(std::string(what) + " has no " + std::to_string(bytes) + "-byte '" + name +
               "' field");
   }
-  return BagFile::LittleEndian(reinterpret_cast<const uint8_t*>(it->second.data()), bytes);
+  return LoadLittleEndian(reinterpret_cast<const uint8_t*>(it->second.data()), bytes);
 }
 
 std::string StringField(BagFile& file, const Fields& fields, const char* name, const char* what) {
@@ -292,7 +273,7 @@ uint64_t ReadChunkInfo(BagFile& file, uint64_t at, std::vector<ChunkInfo>& infos
   const std::vector<uint8_t> data = file.Read(record.data_at, record.data_bytes, "chunk info");
   std::vector<uint32_t> ids;
   for (uint64_t i = 0; i < count; ++i) {
-    ids.push_back(static_cast<uint32_t>(BagFile::LittleEndian(data.data() + 8 * i, 4)));
+    ids.push_back(static_cast<uint32_t>(LoadLittleEndian(data.data() + 8 * i, 4)));
   }
   std::sort(ids.begin(), ids.end());
   info.connections = static_cast<size_t>(std::unique(ids.begin(), ids.end()) - ids.begin());
@@ -343,9 +324,9 @@ uint64_t ReadIndexData(BagFile& file, uint64_t at, uint64_t chunk_pos, const Chu
   std::vector<Entry>& entries = index.entries[id];
   for (uint64_t i = 0; i < count; ++i) {
     Entry entry;
-    entry.sec = static_cast<uint32_t>(BagFile::LittleEndian(data.data() + 12 * i, 4));
-    entry.nsec = static_cast<uint32_t>(BagFile::LittleEndian(data.data() + 12 * i + 4, 4));
-    entry.offset = static_cast<uint32_t>(BagFile::LittleEndian(data.data() + 12 * i + 8, 4));
+    entry.sec = static_cast<uint32_t>(LoadLittleEndian(data.data() + 12 * i, 4));
+    entry.nsec = static_cast<uint32_t>(LoadLittleEndian(data.data() + 12 * i + 4, 4));
+    entry.offset = static_cast<uint32_t>(LoadLittleEndian(data.data() + 12 * i + 8, 4));
     entry.chunk_pos = chunk_pos;
     // rosbag drops (and logs) times outside ros::TIME_MIN..TIME_MAX and
     // normalises nsec over a second: neither is a time a recorder writes.
@@ -432,14 +413,14 @@ std::vector<uint8_t> MessageData(BagFile& file, const std::vector<uint8_t>& chun
   if (uint64_t{offset} + kRecordLengths > chunk.size()) file.Fail(where + " is past its chunk");
   const uint8_t* record = chunk.data() + offset;
   const uint64_t room = chunk.size() - offset - kRecordLengths;
-  const uint64_t header_bytes = BagFile::LittleEndian(record, 4);
+  const uint64_t header_bytes = LoadLittleEndian(record, 4);
   if (header_bytes > room) file.Fail(where + " overruns its chunk");
   const Fields fields = ParseFields(file, record + 4, header_bytes, offset, "message");
   if (UnsignedField(file, fields, "op", 1, "message") != kOpMessageData ||
       UnsignedField(file, fields, "conn", 4, "message") != connection) {
     file.Fail(where + " is not a message of connection " + std::to_string(connection));
   }
-  const uint64_t data_bytes = BagFile::LittleEndian(record + 4 + header_bytes, 4);
+  const uint64_t data_bytes = LoadLittleEndian(record + 4 + header_bytes, 4);
   if (data_bytes > room - header_bytes) file.Fail(where + " overruns its chunk");
   const uint8_t* data = record + kRecordLengths + header_bytes;
   return {data, data + data_bytes};
