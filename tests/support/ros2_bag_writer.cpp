@@ -82,8 +82,8 @@ void InsertMessages(sqlite3* db, const BagTestContents& contents) {
 
 // --- metadata.yaml -----------------------------------------------------------
 
-std::string MetadataYaml(const BagTestContents& contents, const std::string& storage,
-                         const std::string& file_name) {
+// The first and last log time of the messages; {0, 0} for none.
+std::pair<int64_t, int64_t> LogTimeSpan(const BagTestContents& contents) {
   int64_t start = 0;
   int64_t end = 0;
   for (size_t i = 0; i < contents.messages.size(); ++i) {
@@ -91,6 +91,12 @@ std::string MetadataYaml(const BagTestContents& contents, const std::string& sto
     start = i == 0 ? t : std::min(start, t);
     end = i == 0 ? t : std::max(end, t);
   }
+  return {start, end};
+}
+
+std::string MetadataYaml(const BagTestContents& contents, const std::string& storage,
+                         const std::string& file_name) {
+  const auto [start, end] = LogTimeSpan(contents);
   const std::string count = std::to_string(contents.messages.size());
   std::string yaml =
       "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: " + storage +
@@ -225,13 +231,9 @@ struct ChunkWriter {
 
 std::string Statistics(const BagTestContents& contents, const McapIds& ids, size_t chunks) {
   std::map<uint16_t, uint64_t> counts;
-  int64_t start = 0;
-  int64_t end = 0;
-  for (size_t i = 0; i < contents.messages.size(); ++i) {
-    const int64_t t = contents.messages[i].log_time_ns;
-    start = i == 0 ? t : std::min(start, t);
-    end = i == 0 ? t : std::max(end, t);
-    ++counts[static_cast<uint16_t>(TopicIndex(contents, contents.messages[i].topic) + 1)];
+  const auto [start, end] = LogTimeSpan(contents);
+  for (const BagTestMessage& message : contents.messages) {
+    ++counts[static_cast<uint16_t>(TopicIndex(contents, message.topic) + 1)];
   }
   std::string count_map;
   for (const auto& [channel, count] : counts) count_map += mcap::U16(channel) + mcap::U64(count);
