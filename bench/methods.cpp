@@ -40,8 +40,8 @@ class Baseline final : public RegistrationMethod {
 
   std::string Describe() const override { return description_; }
 
-  std::shared_ptr<const PreparedScan> Prepare(const Points& scan) const override {
-    return std::make_shared<const RawScan>(scan);
+  std::shared_ptr<const PreparedScan> Prepare(PointSpan scan) const override {
+    return std::make_shared<const RawScan>(scan.ToPoints());
   }
 
   RegistrationResult Register(const PreparedScan& source, const PreparedScan& target,

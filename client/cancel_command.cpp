@@ -9,32 +9,22 @@
 namespace boicp::cli {
 
 CommandRunner AddCancelCommand(CLI::App& app) {
-  struct Flags {
-    RemoteFlags remote;
-    std::string job_id;
-  };
-  auto flags = std::make_shared<Flags>();
-  app.add_option("JOB", flags->job_id, "Job id")->required();
-  AddRemoteOptions(app, flags->remote);
   app.footer(
       "A queued job is cancelled at once; a running one stops at its next ICP evaluation, "
       "within a few seconds (watch it to see it end). Cancelling a finished job changes "
       "nothing and is not an error.");
-  return [flags] {
-    return RunRemote("cancel", flags->remote, [&] {
-      Daemon daemon = ConnectToDaemon(flags->remote);
-      const v1::Job job = daemon.client->Cancel(flags->job_id);
-      if (job.state() == v1::JOB_STATE_SUCCEEDED || job.state() == v1::JOB_STATE_FAILED) {
-        std::fprintf(stderr, "job %s had already %s; nothing to cancel\n", job.job_id().c_str(),
-                     rpc::JobStateName(job.state()).c_str());
-      } else {
-        std::fprintf(
-            stderr, "job %s: %s\n", job.job_id().c_str(),
-            job.state() == v1::JOB_STATE_CANCELLED ? "cancelled" : "cancel requested, stopping");
-      }
-      return kOk;
-    });
-  };
+  return AddJobCommand(app, "cancel", "Job id", [](Daemon& daemon, const std::string& job_id) {
+    const v1::Job job = daemon.client->Cancel(job_id);
+    if (job.state() == v1::JOB_STATE_SUCCEEDED || job.state() == v1::JOB_STATE_FAILED) {
+      std::fprintf(stderr, "job %s had already %s; nothing to cancel\n", job.job_id().c_str(),
+                   rpc::JobStateName(job.state()).c_str());
+    } else {
+      std::fprintf(
+          stderr, "job %s: %s\n", job.job_id().c_str(),
+          job.state() == v1::JOB_STATE_CANCELLED ? "cancelled" : "cancel requested, stopping");
+    }
+    return kOk;
+  });
 }
 
 }  // namespace boicp::cli

@@ -4,11 +4,11 @@
 
 namespace boicp::cli {
 
-PairSettingsChoice ChooseCloudPairSettings(const Points& source, const Points& target,
-                                           BoIcpConfig config, CloudFormat source_format) {
+PairSettingsChoice ChooseCloudPairSettings(PointSpan source, PointSpan target, BoIcpConfig config,
+                                           CloudFormat source_format) {
   PairSettingsChoice out;
   out.chosen =
-      ChooseSettingsForClouds({&source, &target}, DeclareSensor(config.sensor, source_format),
+      ChooseSettingsForClouds({source, target}, DeclareSensor(config.sensor, source_format),
                               config.seed, 2, config.threads);
   out.auto_fields = ApplyChosenSettings(out.chosen, config);
   ValidateConfig(config);
@@ -16,7 +16,7 @@ PairSettingsChoice ChooseCloudPairSettings(const Points& source, const Points& t
   return out;
 }
 
-RegistrationResult RegisterCloudPair(const Points& source, const Points& target,
+RegistrationResult RegisterCloudPair(PointSpan source, PointSpan target,
                                      const PairSettingsChoice& settings,
                                      const std::optional<Transform>& prior,
                                      const RegistrationCallbacks& callbacks) {

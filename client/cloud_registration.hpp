@@ -26,13 +26,13 @@ struct PairSettingsChoice {
 /// config.sensor says, else as `source_format` and the geometry show) and
 /// validates the result. Throws InputError for clouds too small to choose
 /// from, clouds of different units, or invalid settings.
-PairSettingsChoice ChooseCloudPairSettings(const Points& source, const Points& target,
-                                           BoIcpConfig config, CloudFormat source_format);
+PairSettingsChoice ChooseCloudPairSettings(PointSpan source, PointSpan target, BoIcpConfig config,
+                                           CloudFormat source_format);
 
 /// Registers `source` onto `target` with config.method (T_target_source),
 /// from `prior` when given. Throws Cancelled when callbacks.stop_requested
 /// fires, InputError for clouds the method cannot use.
-RegistrationResult RegisterCloudPair(const Points& source, const Points& target,
+RegistrationResult RegisterCloudPair(PointSpan source, PointSpan target,
                                      const PairSettingsChoice& settings,
                                      const std::optional<Transform>& prior,
                                      const RegistrationCallbacks& callbacks = {});

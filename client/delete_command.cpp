@@ -8,25 +8,15 @@
 namespace boicp::cli {
 
 CommandRunner AddDeleteCommand(CLI::App& app) {
-  struct Flags {
-    RemoteFlags remote;
-    std::string job_id;
-  };
-  auto flags = std::make_shared<Flags>();
-  app.add_option("JOB", flags->job_id, "Job id")->required();
-  AddRemoteOptions(app, flags->remote);
   app.footer(
       "Deletes a succeeded, failed or cancelled job: its record, pair results, trajectory and "
       "output files. A queued or running job must be cancelled first. The scans stay.");
-  return [flags] {
-    return RunRemote("delete", flags->remote, [&] {
-      Daemon daemon = ConnectToDaemon(flags->remote);
-      const v1::DeleteJobResponse deleted = daemon.client->Delete(flags->job_id);
-      std::fprintf(stderr, "job %s deleted (%.1f MB of outputs freed)\n", deleted.job_id().c_str(),
-                   static_cast<double>(deleted.bytes_freed()) / 1e6);
-      return kOk;
-    });
-  };
+  return AddJobCommand(app, "delete", "Job id", [](Daemon& daemon, const std::string& job_id) {
+    const v1::DeleteJobResponse deleted = daemon.client->Delete(job_id);
+    std::fprintf(stderr, "job %s deleted (%.1f MB of outputs freed)\n", deleted.job_id().c_str(),
+                 static_cast<double>(deleted.bytes_freed()) / 1e6);
+    return kOk;
+  });
 }
 
 }  // namespace boicp::cli

@@ -14,6 +14,7 @@
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/io/trajectory_io.hpp"
 #include "commands.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -72,32 +73,27 @@ void WriteDrive(const DemoFlags& f) {
 }
 
 int RunDemoData(const DemoFlags& f) {
-  try {
-    if (f.loop && f.scans == 0) throw InputError("--loop needs --scans N (a drive)");
-    std::filesystem::create_directories(f.out);
-    if (f.scans != 0) {
-      if (f.scans < 2) throw InputError("--scans must be 0 (a pair) or at least 2");
-      if (f.scans > kMaxDriveScans) {
-        throw InputError("--scans must be at most " + std::to_string(kMaxDriveScans));
-      }
-      WriteDrive(f);
-      return kOk;
+  if (f.loop && f.scans == 0) throw InputError("--loop needs --scans N (a drive)");
+  std::filesystem::create_directories(f.out);
+  if (f.scans != 0) {
+    if (f.scans < 2) throw InputError("--scans must be 0 (a pair) or at least 2");
+    if (f.scans > kMaxDriveScans) {
+      throw InputError("--scans must be at most " + std::to_string(kMaxDriveScans));
     }
-    const Points world = MakeSyntheticStreet(f.seed);
-    // The source sensor is 1.5 m further along the street and turned by yaw:
-    // a pose no plain ICP from identity recovers.
-    const Transform T_world_target = PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8});
-    const Transform T_world_source =
-        PoseFromYawTranslation(f.yaw_deg * M_PI / 180.0, {1.5, 0.3, 1.8});
-    WriteXyz(f.out + "/target.xyz", SimulateScan(world, T_world_target, 35.0, 0.02, f.seed + 1));
-    WriteXyz(f.out + "/source.xyz", SimulateScan(world, T_world_source, 35.0, 0.02, f.seed + 2));
-    WriteTransform(f.out + "/truth.txt", T_world_target.inverse() * T_world_source);
-    std::cerr << "wrote " << f.out << "/source.xyz, target.xyz and truth.txt (T_target_source)\n";
+    WriteDrive(f);
     return kOk;
-  } catch (const std::exception& e) {
-    std::cerr << "boicp demo-data: error: " << e.what() << std::endl;
-    return kBadInput;
   }
+  const Points world = MakeSyntheticStreet(f.seed);
+  // The source sensor is 1.5 m further along the street and turned by yaw:
+  // a pose no plain ICP from identity recovers.
+  const Transform T_world_target = PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8});
+  const Transform T_world_source =
+      PoseFromYawTranslation(f.yaw_deg * M_PI / 180.0, {1.5, 0.3, 1.8});
+  WriteXyz(f.out + "/target.xyz", SimulateScan(world, T_world_target, 35.0, 0.02, f.seed + 1));
+  WriteXyz(f.out + "/source.xyz", SimulateScan(world, T_world_source, 35.0, 0.02, f.seed + 2));
+  WriteTransform(f.out + "/truth.txt", T_world_target.inverse() * T_world_source);
+  std::cerr << "wrote " << f.out << "/source.xyz, target.xyz and truth.txt (T_target_source)\n";
+  return kOk;
 }
 
 }  // namespace
@@ -114,7 +110,7 @@ CommandRunner AddDemoDataCommand(CLI::App& app) {
   app.add_flag("--loop", flags->loop,
                "With --scans: drive out along the street and back in the other lane, ending "
                "beside the start");
-  return [flags] { return RunDemoData(*flags); };
+  return [flags] { return RunCommand("demo-data", [&] { return RunDemoData(*flags); }); };
 }
 
 }  // namespace boicp::cli

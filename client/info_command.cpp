@@ -9,6 +9,7 @@
 #include "boicp/io/bag_reader.hpp"
 #include "boicp/util/types.hpp"
 #include "commands.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -47,22 +48,14 @@ void PrintInfo(const json& info) {
 }
 
 int RunInfo(const InfoFlags& flags) {
-  try {
-    const std::unique_ptr<BagReader> bag = OpenBag(flags.path);
-    const json info = InfoJson(*bag);
-    if (flags.json) {
-      std::cout << info.dump() << std::endl;
-    } else {
-      PrintInfo(info);
-    }
-    return kOk;
-  } catch (const InputError& e) {
-    std::cerr << "boicp info: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "boicp info: error: " << e.what() << std::endl;
-    return kFailure;
+  const std::unique_ptr<BagReader> bag = OpenBag(flags.path);
+  const json info = InfoJson(*bag);
+  if (flags.json) {
+    std::cout << info.dump() << std::endl;
+  } else {
+    PrintInfo(info);
   }
+  return kOk;
 }
 
 }  // namespace
@@ -74,7 +67,7 @@ CommandRunner AddInfoCommand(CLI::App& app) {
   app.add_flag("--json", flags->json,
                "One JSON object on stdout: path, storage, start, duration (s), topics [{name, "
                "type, messages}]");
-  return [flags] { return RunInfo(*flags); };
+  return [flags] { return RunCommand("info", [&] { return RunInfo(*flags); }); };
 }
 
 }  // namespace boicp::cli

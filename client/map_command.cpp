@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "local_map.hpp"
 #include "map_settings_flags.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -103,36 +104,25 @@ int BuildMap(const LocalRun& run, const MapFlags& flags,
 
 int RunMap(MapFlags flags) {
   const auto start = std::chrono::steady_clock::now();
-  try {
-    if (flags.out_dir.empty()) throw InputError("-o OUTDIR is required");
-    if (flags.threads < 1) throw InputError("--threads: must be >= 1");
-    LocalRun run = PrepareRun(WithAbsolutePaths(ResolveMapSettings(flags.map)));
-    const std::string& out = flags.out_dir;
-    const bool sharded = !flags.shard.empty();
-    const Shard shard = sharded ? ParseShard(flags.shard) : Shard{};
-    if (sharded && run.batch.plan.keyframes) {
-      throw InputError(
-          "--shard: overlap pairing chooses its pairs as results come in; shard "
-          "consecutive or explicit pairing");
-    }
-    if (sharded) CheckShardManifest(run, out);
-    // Shards fuse nothing, but their merge would refuse what this refuses.
-    ChooseMapRunSettings(run, flags.threads, flags.max_fusion_mb);
-    std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.description.c_str());
-    PrintRunSettings(run);
-    if (!sharded) return BuildMap(run, flags, start);
-    ClaimShardManifest(run, out);
-    return RunShard(run, shard, flags);
-  } catch (const InputError& e) {
-    std::cerr << "boicp map: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const LimitExceeded& e) {  // settings the scans do not fit
-    std::cerr << "boicp map: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "boicp map: error: " << e.what() << std::endl;
-    return kFailure;
+  if (flags.out_dir.empty()) throw InputError("-o OUTDIR is required");
+  if (flags.threads < 1) throw InputError("--threads: must be >= 1");
+  LocalRun run = PrepareRun(WithAbsolutePaths(ResolveMapSettings(flags.map)));
+  const std::string& out = flags.out_dir;
+  const bool sharded = !flags.shard.empty();
+  const Shard shard = sharded ? ParseShard(flags.shard) : Shard{};
+  if (sharded && run.batch.plan.keyframes) {
+    throw InputError(
+        "--shard: overlap pairing chooses its pairs as results come in; shard "
+        "consecutive or explicit pairing");
   }
+  if (sharded) CheckShardManifest(run, out);
+  // Shards fuse nothing, but their merge would refuse what this refuses.
+  ChooseMapRunSettings(run, flags.threads, flags.max_fusion_mb);
+  std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.description.c_str());
+  PrintRunSettings(run);
+  if (!sharded) return BuildMap(run, flags, start);
+  ClaimShardManifest(run, out);
+  return RunShard(run, shard, flags);
 }
 
 }  // namespace
@@ -150,7 +140,7 @@ CommandRunner AddMapCommand(CLI::App& app) {
                  "K/N: register only pairs K-1 mod N into OUTDIR/pairs, no map (then merge)");
   AddFusionLimitFlag(app, f.max_fusion_mb);
   app.add_flag("--json", f.json, "Print a JSON summary on stdout");
-  return [flags] { return RunMap(*flags); };
+  return [flags] { return RunCommand("map", [&] { return RunMap(*flags); }); };
 }
 
 }  // namespace boicp::cli

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "local_map.hpp"
 #include "map_settings_flags.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -36,43 +37,32 @@ MapSettings AgreedManifest(const std::vector<std::string>& dirs) {
 }
 
 int RunMerge(const MergeFlags& flags) {
-  try {
-    LocalRun run = PrepareRun(AgreedManifest(flags.shard_dirs));
-    if (run.batch.plan.keyframes) {
-      throw InputError(RunManifestPath(flags.shard_dirs.front()) +
-                       ": overlap pairing is not sharded; run boicp map instead");
-    }
-    // The shards' own choice: the same scans give the same settings.
-    ChooseMapRunSettings(run, AvailableCores(), flags.max_fusion_mb);
-    const std::map<PairIndex, PairResult> results =
-        ReadStoredPairs(run, FixedPlanPairs(run.batch.plan), flags.shard_dirs);
-    std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(), run.description.c_str(),
-                 results.size());
-    PrintRunSettings(run);
-    WriteRunManifest(run, flags.out_dir);
-    const MapOutputSummary summary = AssembleStoredPairs(run, results, flags.out_dir);
-    PrintMapClosing(summary, flags.out_dir);
-    if (flags.json) {
-      std::cout << json{{"scans", run.batch.scans.size()},
-                        {"pairs", results.size()},
-                        {"pairs_doubtful", summary.pairs_doubtful},
-                        {"pose_graph_optimised", summary.optimised},
-                        {"occupied_leaves", summary.occupied_leaves},
-                        {"out", flags.out_dir}}
-                       .dump()
-                << std::endl;
-    }
-    return kOk;
-  } catch (const InputError& e) {
-    std::cerr << "boicp merge: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const LimitExceeded& e) {  // settings the scans do not fit
-    std::cerr << "boicp merge: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "boicp merge: error: " << e.what() << std::endl;
-    return kFailure;
+  LocalRun run = PrepareRun(AgreedManifest(flags.shard_dirs));
+  if (run.batch.plan.keyframes) {
+    throw InputError(RunManifestPath(flags.shard_dirs.front()) +
+                     ": overlap pairing is not sharded; run boicp map instead");
   }
+  // The shards' own choice: the same scans give the same settings.
+  ChooseMapRunSettings(run, AvailableCores(), flags.max_fusion_mb);
+  const std::map<PairIndex, PairResult> results =
+      ReadStoredPairs(run, FixedPlanPairs(run.batch.plan), flags.shard_dirs);
+  std::fprintf(stderr, "%s: %s, %zu pairs\n", run.settings.path.c_str(), run.description.c_str(),
+               results.size());
+  PrintRunSettings(run);
+  WriteRunManifest(run, flags.out_dir);
+  const MapOutputSummary summary = AssembleStoredPairs(run, results, flags.out_dir);
+  PrintMapClosing(summary, flags.out_dir);
+  if (flags.json) {
+    std::cout << json{{"scans", run.batch.scans.size()},
+                      {"pairs", results.size()},
+                      {"pairs_doubtful", summary.pairs_doubtful},
+                      {"pose_graph_optimised", summary.optimised},
+                      {"occupied_leaves", summary.occupied_leaves},
+                      {"out", flags.out_dir}}
+                     .dump()
+              << std::endl;
+  }
+  return kOk;
 }
 
 }  // namespace
@@ -85,7 +75,7 @@ CommandRunner AddMergeCommand(CLI::App& app) {
   app.add_option("-o,--out", flags->out_dir, "Output folder (may be the shards' own)")->required();
   AddFusionLimitFlag(app, flags->max_fusion_mb);
   app.add_flag("--json", flags->json, "Print a JSON summary on stdout");
-  return [flags] { return RunMerge(*flags); };
+  return [flags] { return RunCommand("merge", [&] { return RunMerge(*flags); }); };
 }
 
 }  // namespace boicp::cli

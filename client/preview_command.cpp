@@ -7,6 +7,7 @@
 #include "boicp/mapping/map_preview.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -34,24 +35,16 @@ std::vector<Transform> ReadTrajectory(const std::string& path) {
 }
 
 int RunPreview(const PreviewFlags& f) {
-  try {
-    const std::vector<Transform> poses =
-        f.trajectory.empty() ? std::vector<Transform>{} : ReadTrajectory(f.trajectory);
-    PreviewOptions options;
-    options.size_px = f.size;
-    UpDetectionOptions up_options;
-    up_options.sensor_up = ParseSensorUp(f.sensor_up);
-    if (up_options.sensor_up && poses.empty()) throw InputError("--sensor-up: needs --trajectory");
-    const UpDirection up = WriteMapPreview(f.map, poses, f.out, options, up_options);
-    std::cerr << "wrote " << f.out << " (" << up.reason << ")\n";
-    return kOk;
-  } catch (const InputError& e) {
-    std::cerr << "boicp preview: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "boicp preview: error: " << e.what() << std::endl;
-    return kFailure;
-  }
+  const std::vector<Transform> poses =
+      f.trajectory.empty() ? std::vector<Transform>{} : ReadTrajectory(f.trajectory);
+  PreviewOptions options;
+  options.size_px = f.size;
+  UpDetectionOptions up_options;
+  up_options.sensor_up = ParseSensorUp(f.sensor_up);
+  if (up_options.sensor_up && poses.empty()) throw InputError("--sensor-up: needs --trajectory");
+  const UpDirection up = WriteMapPreview(f.map, poses, f.out, options, up_options);
+  std::cerr << "wrote " << f.out << " (" << up.reason << ")\n";
+  return kOk;
 }
 
 }  // namespace
@@ -64,7 +57,7 @@ CommandRunner AddPreviewCommand(CLI::App& app) {
   app.add_option("--sensor-up", flags->sensor_up, kSensorUpHelp);
   app.add_option("--size", flags->size, "Longer side of the image (pixels, >= 64)")
       ->capture_default_str();
-  return [flags] { return RunPreview(*flags); };
+  return [flags] { return RunCommand("preview", [&] { return RunPreview(*flags); }); };
 }
 
 }  // namespace boicp::cli

@@ -13,6 +13,7 @@
 #include "cli_parsing.hpp"
 #include "cloud_registration.hpp"
 #include "commands.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -85,51 +86,43 @@ void PrintHuman(const RegistrationResult& r) {
 }
 
 int RunRegister(const RegisterFlags& flags) {
-  try {
-    const BoIcpConfig config = BuildConfig(flags);
-    const LoadOptions load = BuildLoadOptions(flags);
-    if (!(flags.scale_source > 0.0) || !std::isfinite(flags.scale_source)) {
-      throw InputError("--scale-source must be a positive number");
-    }
-    LoadedCloud source = LoadPointCloud(flags.source, load);
-    if (flags.scale_source != 1.0) {
-      for (Point& p : source.points) p *= flags.scale_source;
-    }
-    const LoadedCloud target = LoadPointCloud(flags.target, load);
-    std::optional<Transform> prior;
-    if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
-    const PairSettingsChoice settings =
-        ChooseCloudPairSettings(source.points, target.points, config, source.format);
-    const ChosenSettings& chosen = settings.chosen;
-    if (!flags.quiet) {
-      std::fprintf(stderr,
-                   "loaded %zu source and %zu target points (%zu and %zu non-finite dropped)\n",
-                   source.points.size(), target.points.size(), source.dropped_nonfinite,
-                   target.dropped_nonfinite);
-      std::fprintf(stderr, "%s\n",
-                   DescribeSettings(settings.config, settings.auto_fields, chosen).c_str());
-      if (chosen.far_returns[0] + chosen.far_returns[1] > 0) {
-        std::fprintf(stderr,
-                     "%zu source and %zu target points set aside as far returns when choosing "
-                     "the settings (they stay in the scans)\n",
-                     chosen.far_returns[0], chosen.far_returns[1]);
-      }
-    }
-    const RegistrationResult result = RegisterCloudPair(source.points, target.points, settings,
-                                                        prior, MakeProgressPrinter(flags.quiet));
-    if (flags.json) {
-      std::cout << RegisterReportJson(result, settings).dump() << std::endl;
-    } else {
-      PrintHuman(result);
-    }
-    return kOk;
-  } catch (const InputError& e) {
-    std::cerr << "boicp register: error: " << e.what() << std::endl;
-    return kBadInput;
-  } catch (const std::exception& e) {
-    std::cerr << "boicp register: internal error: " << e.what() << std::endl;
-    return kFailure;
+  const BoIcpConfig config = BuildConfig(flags);
+  const LoadOptions load = BuildLoadOptions(flags);
+  if (!(flags.scale_source > 0.0) || !std::isfinite(flags.scale_source)) {
+    throw InputError("--scale-source must be a positive number");
   }
+  LoadedCloud source = LoadPointCloud(flags.source, load);
+  if (flags.scale_source != 1.0) {
+    for (Point& p : source.points) p *= flags.scale_source;
+  }
+  const LoadedCloud target = LoadPointCloud(flags.target, load);
+  std::optional<Transform> prior;
+  if (!flags.prior_file.empty()) prior = ReadTransformFile(flags.prior_file);
+  const PairSettingsChoice settings =
+      ChooseCloudPairSettings(source.points, target.points, config, source.format);
+  const ChosenSettings& chosen = settings.chosen;
+  if (!flags.quiet) {
+    std::fprintf(stderr,
+                 "loaded %zu source and %zu target points (%zu and %zu non-finite dropped)\n",
+                 source.points.size(), target.points.size(), source.dropped_nonfinite,
+                 target.dropped_nonfinite);
+    std::fprintf(stderr, "%s\n",
+                 DescribeSettings(settings.config, settings.auto_fields, chosen).c_str());
+    if (chosen.far_returns[0] + chosen.far_returns[1] > 0) {
+      std::fprintf(stderr,
+                   "%zu source and %zu target points set aside as far returns when choosing "
+                   "the settings (they stay in the scans)\n",
+                   chosen.far_returns[0], chosen.far_returns[1]);
+    }
+  }
+  const RegistrationResult result = RegisterCloudPair(source.points, target.points, settings, prior,
+                                                      MakeProgressPrinter(flags.quiet));
+  if (flags.json) {
+    std::cout << RegisterReportJson(result, settings).dump() << std::endl;
+  } else {
+    PrintHuman(result);
+  }
+  return kOk;
 }
 
 }  // namespace
@@ -156,7 +149,7 @@ CommandRunner AddRegisterCommand(CLI::App& app) {
                  "when the target is in metres); the prior and the answer map the scaled source")
       ->capture_default_str();
   settings::AddSettingFlags(app, settings::kRegister, f.settings, f.setting_texts);
-  return [flags] { return RunRegister(*flags); };
+  return [flags] { return RunCommand("register", [&] { return RunRegister(*flags); }); };
 }
 
 }  // namespace boicp::cli

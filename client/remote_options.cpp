@@ -1,13 +1,12 @@
 #include "remote_options.hpp"
 
 #include <fstream>
-#include <iostream>
 #include <sstream>
 
 #include "boicp/util/text.hpp"
 #include "boicp/util/types.hpp"
 #include "commands.hpp"
-#include "printable_text.hpp"
+#include "run_command.hpp"
 
 namespace boicp::cli {
 namespace {
@@ -102,20 +101,32 @@ Daemon ConnectToDaemon(const RemoteFlags& flags) {
 
 int RunRemote(const std::string& command, const RemoteFlags& flags,
               const std::function<int()>& body) {
-  const auto report = [&](const std::string& message, int code) {
-    // The daemon's messages may span lines or carry what a client sent.
-    std::cerr << "boicp " << command << ": error: " << PrintableText(message) << std::endl;
-    return code;
+  return RunCommand(command, [&] {
+    try {
+      return body();
+    } catch (const rpc::RpcError& e) {
+      return ReportCommandError(command, DescribeRpcError(e, flags),
+                                IsBadInput(e.code()) ? kBadInput : kFailure);
+    }
+  });
+}
+
+std::function<int()> AddJobCommand(CLI::App& app, const std::string& command,
+                                   const std::string& job_help,
+                                   std::function<int(Daemon&, const std::string& job_id)> run) {
+  struct Flags {
+    RemoteFlags remote;
+    std::string job_id;
   };
-  try {
-    return body();
-  } catch (const rpc::RpcError& e) {
-    return report(DescribeRpcError(e, flags), IsBadInput(e.code()) ? kBadInput : kFailure);
-  } catch (const InputError& e) {
-    return report(e.what(), kBadInput);
-  } catch (const std::exception& e) {
-    return report(e.what(), kFailure);
-  }
+  auto flags = std::make_shared<Flags>();
+  app.add_option("JOB", flags->job_id, job_help)->required();
+  AddRemoteOptions(app, flags->remote);
+  return [flags, command, run = std::move(run)] {
+    return RunRemote(command, flags->remote, [&] {
+      Daemon daemon = ConnectToDaemon(flags->remote);
+      return run(daemon, flags->job_id);
+    });
+  };
 }
 
 }  // namespace boicp::cli

@@ -60,4 +60,10 @@ class JobEndedBadly : public std::runtime_error {
 int RunRemote(const std::string& command, const RemoteFlags& flags,
               const std::function<int()>& body);
 
+/// A command on one job: the JOB argument (described by `job_help`), the
+/// remote options, and a runner that connects and calls `run` under RunRemote.
+std::function<int()> AddJobCommand(CLI::App& app, const std::string& command,
+                                   const std::string& job_help,
+                                   std::function<int(Daemon&, const std::string& job_id)> run);
+
 }  // namespace boicp::cli

@@ -6,7 +6,6 @@
 #include <cstdio>
 
 #include "boicp/rpc/proto_convert.hpp"
-#include "boicp/rpc/settings_proto.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"

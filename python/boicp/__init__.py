@@ -79,7 +79,10 @@ def register(source, target, *, config="C", budget=None, prior=None, seed=1, thr
     """Registers ``source`` onto ``target``; returns a Result (T_target_source).
 
     source, target: (N, 3) float64 or float32 arrays of points, metres, each in
-        its sensor's frame (non-finite points are an error).
+        its sensor's frame (non-finite points are an error). A float64 array
+        whose rows hold x, y, z side by side (C order, or the first three
+        columns of a wider C-order array) is read where it lies, not copied;
+        do not change it while register runs.
     config: the paper's preset, "A", "B" or "C".
     budget: "auto" (the escalation ladder, the default) or "fixed" (the
         paper's full search).
@@ -98,6 +101,9 @@ def register(source, target, *, config="C", budget=None, prior=None, seed=1, thr
 def read_scan(path, format="auto", *, intrinsics=None, intrinsics_file="", depth_scale=0.0,
               invalid_depth=(0, 65535), max_points=5_000_000):
     """The points of a scan file as an (N, 3) float64 array, metres, non-finite dropped.
+
+    The array owns the points as the loader read them (no copy), and register
+    reads it in place.
 
     format: "auto" (from the extension), "kitti", "pcd", "ply", "xyz" or "depth".
     intrinsics: a depth image's camera, (fx, fy, cx, cy) in pixels or "fx,fy,cx,cy";

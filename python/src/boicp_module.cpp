@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <pybind11/pybind11.h>
@@ -68,8 +69,8 @@ void RunInterruptibly(PythonInterrupt& interrupt, Work work) {
 
 py::object RegisterClouds(const py::array& source_array, const py::array& target_array,
                           const py::dict& settings, const py::object& prior_array) {
-  const Points source = PointsFromArray(source_array, "source");
-  const Points target = PointsFromArray(target_array, "target");
+  const ArrayPoints source(source_array, "source");
+  const ArrayPoints target(target_array, "target");
   std::optional<Transform> prior;
   if (!prior_array.is_none()) prior = TransformFromArray(py::array(prior_array), "prior");
   settings::RequestedSettings requested =
@@ -82,11 +83,11 @@ py::object RegisterClouds(const py::array& source_array, const py::array& target
   json report;
   RunInterruptibly(interrupt, [&] {
     const cli::PairSettingsChoice chosen =
-        cli::ChooseCloudPairSettings(source, target, config, CloudFormat::kAuto);
+        cli::ChooseCloudPairSettings(source.span(), target.span(), config, CloudFormat::kAuto);
     RegistrationCallbacks callbacks;
     callbacks.stop_requested = [&interrupt] { return interrupt.Requested(); };
     report = cli::RegisterReportJson(
-        cli::RegisterCloudPair(source, target, chosen, prior, callbacks), chosen);
+        cli::RegisterCloudPair(source.span(), target.span(), chosen, prior, callbacks), chosen);
   });
   return PythonOf(report);
 }
@@ -111,7 +112,7 @@ py::array_t<double> ReadScan(const std::string& path, const std::string& format,
     py::gil_scoped_release release;
     cloud = LoadPointCloud(path, options);
   }
-  return ArrayFromPoints(cloud.points);
+  return ArrayFromPoints(std::move(cloud.points));
 }
 
 py::object BuildMap(const std::string& folder, const std::string& out_dir, const py::dict& settings,
@@ -200,6 +201,10 @@ PYBIND11_MODULE(_boicp, m) {
   m.attr("__version__") = BOICP_VERSION;
   m.def("register_clouds", &RegisterClouds, py::arg("source"), py::arg("target"),
         py::arg("settings"), py::arg("prior"));
+  m.def(
+      "_reads_in_place",
+      [](const py::array& points) { return ArrayPoints(points, "points").in_place(); },
+      py::arg("points"), "Whether register reads `points` where they lie rather than from a copy.");
   m.def("read_scan", &ReadScan, py::arg("path"), py::arg("format"), py::arg("intrinsics"),
         py::arg("intrinsics_file"), py::arg("depth_scale"), py::arg("invalid_depth"),
         py::arg("max_points"));

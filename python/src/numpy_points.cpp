@@ -1,6 +1,9 @@
 #include "numpy_points.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "boicp/io/point_cloud_io.hpp"
 
@@ -9,48 +12,67 @@ namespace py = pybind11;
 
 namespace {
 
-template <typename Scalar>
-Points ReadRows(const py::array& array, const std::string& what) {
-  // unchecked<> honours the array's strides, so views and Fortran order read as they are.
-  const auto rows = py::array_t<Scalar, py::array::forcecast>(array).template unchecked<2>();
-  Points points(static_cast<size_t>(rows.shape(0)));
+// Where a float64 array's rows can be read as they lie: three adjacent
+// doubles a row, rows a whole number of doubles apart.
+bool RowsReadableInPlace(const py::array& array) {
+  constexpr py::ssize_t kDouble = sizeof(double);
+  return py::isinstance<py::array_t<double>>(array) && array.strides(1) == kDouble &&
+         array.strides(0) >= 3 * kDouble && array.strides(0) % kDouble == 0 &&
+         reinterpret_cast<std::uintptr_t>(array.data()) % alignof(double) == 0;
+}
+
+void RequireFinite(PointSpan points, const std::string& what) {
   size_t not_finite = 0;
-  for (py::ssize_t i = 0; i < rows.shape(0); ++i) {
-    Point& p = points[static_cast<size_t>(i)];
-    p = Point(rows(i, 0), rows(i, 1), rows(i, 2));
-    not_finite += !p.allFinite();
-  }
+  for (const Point& p : points) not_finite += !p.allFinite();
   if (not_finite > 0) {
     throw InputError(what + ": " + std::to_string(not_finite) + " of " +
                      std::to_string(points.size()) +
                      " points are not finite; keep the finite ones "
                      "(points[numpy.isfinite(points).all(axis=1)])");
   }
-  return points;
 }
 
 }  // namespace
 
-Points PointsFromArray(const py::array& array, const std::string& what) {
+ArrayPoints::ArrayPoints(const py::array& array, const std::string& what) : array_(array) {
   if (array.ndim() != 2 || array.shape(1) != 3) {
     throw InputError(what + ": expected an (N, 3) array of points, got shape " +
                      py::str(py::tuple(py::cast(std::vector<py::ssize_t>(
                                  array.shape(), array.shape() + array.ndim()))))
                          .cast<std::string>());
   }
-  if (array.dtype().is(py::dtype::of<double>())) return ReadRows<double>(array, what);
-  if (array.dtype().is(py::dtype::of<float>())) return ReadRows<float>(array, what);
-  throw InputError(what + ": expected float64 or float32 points, got " +
-                   py::str(array.dtype()).cast<std::string>());
+  const char kind = array.dtype().kind();
+  const py::ssize_t size = array.dtype().itemsize();
+  if (kind != 'f' || (size != 8 && size != 4)) {
+    throw InputError(what + ": expected float64 or float32 points, got " +
+                     py::str(array.dtype()).cast<std::string>());
+  }
+  const auto rows = static_cast<size_t>(array.shape(0));
+  if (RowsReadableInPlace(array)) {
+    span_ = PointSpan(static_cast<const double*>(array.data()), rows,
+                      static_cast<size_t>(array.strides(0)) / sizeof(double));
+  } else {
+    // The converted array must outlive `cells`, which points into it;
+    // unchecked<> honours its strides, so views and Fortran order read as they are.
+    const py::array_t<double, py::array::forcecast> converted(array);
+    const auto cells = converted.unchecked<2>();
+    copy_.resize(rows);
+    for (size_t i = 0; i < rows; ++i) {
+      const auto r = static_cast<py::ssize_t>(i);
+      copy_[i] = Point(cells(r, 0), cells(r, 1), cells(r, 2));
+    }
+    span_ = copy_;
+  }
+  RequireFinite(span_, what);
 }
 
-py::array_t<double> ArrayFromPoints(const Points& points) {
-  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
-  auto rows = out.mutable_unchecked<2>();
-  for (size_t i = 0; i < points.size(); ++i) {
-    for (py::ssize_t j = 0; j < 3; ++j) rows(static_cast<py::ssize_t>(i), j) = points[i][j];
-  }
-  return out;
+py::array_t<double> ArrayFromPoints(Points points) {
+  auto* owned = new Points(std::move(points));
+  const py::capsule free_when_done(owned, [](void* p) { delete static_cast<Points*>(p); });
+  const auto rows = static_cast<py::ssize_t>(owned->size());
+  constexpr auto kRow = static_cast<py::ssize_t>(sizeof(Point));
+  return py::array_t<double>({rows, py::ssize_t{3}}, {kRow, py::ssize_t{sizeof(double)}},
+                             owned->empty() ? nullptr : owned->front().data(), free_when_done);
 }
 
 Transform TransformFromArray(const py::array& array, const std::string& what) {

@@ -143,6 +143,25 @@ def test_float32_and_strided_arrays_give_the_same_answer(pair):
     np.testing.assert_allclose(as_float32.transform, as_float64.transform, atol=1e-3)
 
 
+def test_float64_rows_are_read_in_place_and_other_layouts_copied(pair):
+    source = boicp.read_scan(pair / "source.xyz")
+    target = boicp.read_scan(pair / "target.xyz")
+    in_place = boicp._boicp._reads_in_place
+    # read_scan's array holds the loader's own points, and register reads them there.
+    assert not source.flags.owndata and source.base is not None
+    assert in_place(source)
+    with_normals = np.hstack([source, np.ones_like(source)])
+    assert in_place(with_normals[:, :3])
+    for copied in (np.asfortranarray(source), source[::-1], source.astype(np.float32),
+                   source.astype(">f8")):
+        assert not in_place(copied)
+    # Viewed or copied, the engine reads the same numbers.
+    reference = boicp.register(source, target, threads=1, **QUICK)
+    for layout in (with_normals[:, :3], source.astype(">f8")):
+        np.testing.assert_array_equal(
+            boicp.register(layout, target, threads=1, **QUICK).transform, reference.transform)
+
+
 def test_a_prior_is_used(pair):
     source = boicp.read_scan(pair / "source.xyz")
     target = boicp.read_scan(pair / "target.xyz")

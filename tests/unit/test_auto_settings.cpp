@@ -44,7 +44,7 @@ Points Scaled(const Points& points, double factor) {
 
 TEST(AutoSettings, LevelLidarTurnsOnlyAboutZ) {
   const Points scan = StreetScan();
-  const ChosenSettings chosen = ChooseSettingsForClouds({&scan, &scan}, std::nullopt, 1);
+  const ChosenSettings chosen = ChooseSettingsForClouds({scan, scan}, std::nullopt, 1);
   EXPECT_EQ(chosen.sensor, SensorKind::kLidar);
   EXPECT_DOUBLE_EQ(chosen.rotation_bounds.z(), M_PI);
   EXPECT_LT(chosen.rotation_bounds.x(), 0.5);
@@ -67,7 +67,7 @@ Points WithoutAzimuths(const Points& points, double from_deg, double to_deg) {
 // LiDAR's; with most of it blocked it is a view, and the reason says which.
 TEST(AutoSettings, TheSensorSaysWhyAndARingWithAGapIsARing) {
   const Points scan = StreetScan();
-  const ChosenSettings full = ChooseSettingsForClouds({&scan, &scan}, std::nullopt, 1);
+  const ChosenSettings full = ChooseSettingsForClouds({scan, scan}, std::nullopt, 1);
   EXPECT_EQ(full.sensor, SensorKind::kLidar);
   EXPECT_THAT(full.sensor_reason, HasSubstr("ring covering 360 deg"));
   // The sensor is 1.8 m up; the plane is found within half a search voxel.
@@ -77,21 +77,21 @@ TEST(AutoSettings, TheSensorSaysWhyAndARingWithAGapIsARing) {
   EXPECT_THAT(full.sensor_reason, HasSubstr("m below the origin"));
 
   const Points blocked = WithoutAzimuths(scan, -60.0, 40.0);  // 100 degrees behind an operator
-  const ChosenSettings gap = ChooseSettingsForClouds({&scan, &blocked}, std::nullopt, 1);
+  const ChosenSettings gap = ChooseSettingsForClouds({scan, blocked}, std::nullopt, 1);
   EXPECT_EQ(gap.sensor, SensorKind::kLidar);
   EXPECT_EQ(gap.rotation_bounds, full.rotation_bounds);
   EXPECT_THAT(gap.sensor_reason, HasSubstr("ring covering 260 deg"));
 
   const Points half = WithoutAzimuths(scan, -90.0, 90.0);
-  const ChosenSettings view = ChooseSettingsForClouds({&scan, &half}, std::nullopt, 1);
+  const ChosenSettings view = ChooseSettingsForClouds({scan, half}, std::nullopt, 1);
   EXPECT_NE(view.sensor, SensorKind::kLidar);
   EXPECT_THAT(view.sensor_reason, HasSubstr("one-sided view"));
 
   const Points camera = CameraView();
-  EXPECT_THAT(ChooseSettingsForClouds({&camera}, std::nullopt, 1).sensor_reason,
+  EXPECT_THAT(ChooseSettingsForClouds({camera}, std::nullopt, 1).sensor_reason,
               HasSubstr("one-sided view (mean direction 0."));
   EXPECT_EQ(
-      ChooseSettingsForClouds({&camera}, DeclareSensor(std::nullopt, CloudFormat::kDepthPng), 1)
+      ChooseSettingsForClouds({camera}, DeclareSensor(std::nullopt, CloudFormat::kDepthPng), 1)
           .sensor_reason,
       "depth images");
 }
@@ -100,11 +100,11 @@ TEST(AutoSettings, ConeOfViewMayTurnAnyhow) {
   const Points view = CameraView();
   for (CloudFormat format : {CloudFormat::kAuto, CloudFormat::kDepthPng}) {
     const ChosenSettings chosen =
-        ChooseSettingsForClouds({&view}, DeclareSensor(std::nullopt, format), 1);
+        ChooseSettingsForClouds({view}, DeclareSensor(std::nullopt, format), 1);
     EXPECT_NE(chosen.sensor, SensorKind::kLidar);
     EXPECT_EQ(chosen.rotation_bounds, Eigen::Vector3d(M_PI, M_PI / 2, M_PI));
   }
-  EXPECT_EQ(ChooseSettingsForClouds({&view}, DeclareSensor(std::nullopt, CloudFormat::kDepthPng), 1)
+  EXPECT_EQ(ChooseSettingsForClouds({view}, DeclareSensor(std::nullopt, CloudFormat::kDepthPng), 1)
                 .sensor,
             SensorKind::kDepthCamera);
 }
@@ -114,27 +114,27 @@ TEST(AutoSettings, ConeOfViewMayTurnAnyhow) {
 TEST(AutoSettings, ASetSensorOverridesTheFormatAndTheGeometry) {
   const Points street = StreetScan();
   const ChosenSettings depth = ChooseSettingsForClouds(
-      {&street}, DeclareSensor(SensorKind::kDepthCamera, CloudFormat::kKittiBin), 1);
+      {street}, DeclareSensor(SensorKind::kDepthCamera, CloudFormat::kKittiBin), 1);
   EXPECT_EQ(depth.sensor, SensorKind::kDepthCamera);
   EXPECT_EQ(depth.sensor_reason, "set by --sensor");
   EXPECT_EQ(depth.rotation_bounds, Eigen::Vector3d(M_PI, M_PI / 2, M_PI));
 
   const ChosenSettings lidar =
-      ChooseSettingsForClouds({&street}, DeclareSensor(SensorKind::kLidar, CloudFormat::kAuto), 1);
+      ChooseSettingsForClouds({street}, DeclareSensor(SensorKind::kLidar, CloudFormat::kAuto), 1);
   EXPECT_EQ(lidar.sensor, SensorKind::kLidar);
   EXPECT_THAT(lidar.sensor_reason, HasSubstr("set by --sensor, ground plane"));
   EXPECT_LT(lidar.rotation_bounds.x(), 0.5);
 
   const Points view = CameraView();
   const ChosenSettings tilted =
-      ChooseSettingsForClouds({&view}, DeclareSensor(SensorKind::kLidar, CloudFormat::kAuto), 1);
+      ChooseSettingsForClouds({view}, DeclareSensor(SensorKind::kLidar, CloudFormat::kAuto), 1);
   EXPECT_EQ(tilted.sensor, SensorKind::kLidar);
   EXPECT_EQ(tilted.sensor_reason,
             "set by --sensor, no ground plane below the origin in every scan");
   EXPECT_EQ(tilted.rotation_bounds, Eigen::Vector3d(M_PI, M_PI / 2, M_PI));
 
   EXPECT_EQ(
-      ChooseSettingsForClouds({&street}, DeclareSensor(SensorKind::kOther, CloudFormat::kAuto), 1)
+      ChooseSettingsForClouds({street}, DeclareSensor(SensorKind::kOther, CloudFormat::kAuto), 1)
           .sensor,
       SensorKind::kOther);
 }
@@ -158,8 +158,8 @@ TEST(AutoSettings, TheSensorSettingReadsItsWordsAndNamesTheChoices) {
 TEST(AutoSettings, LengthsFollowTheScenesScale) {
   const Points view = CameraView();
   const Points large = Scaled(view, 10.0);
-  const ChosenSettings small = ChooseSettingsForClouds({&view}, std::nullopt, 1);
-  const ChosenSettings big = ChooseSettingsForClouds({&large}, std::nullopt, 1);
+  const ChosenSettings small = ChooseSettingsForClouds({view}, std::nullopt, 1);
+  const ChosenSettings big = ChooseSettingsForClouds({large}, std::nullopt, 1);
   EXPECT_NEAR(big.voxel, 10.0 * small.voxel, 1e-6 * big.voxel);
   EXPECT_TRUE(big.translation_bounds.isApprox(10.0 * small.translation_bounds, 1e-6));
   EXPECT_NEAR(big.map_resolution, 10.0 * small.map_resolution, 1e-6 * big.map_resolution);
@@ -172,16 +172,16 @@ TEST(AutoSettings, CloudsInOtherUnitsAreAnErrorNamingBothScales) {
   const Points metres = CameraView();
   const Points millimetres = Scaled(metres, 1000.0);
   const Points ten_times = Scaled(metres, 10.0);
-  EXPECT_NO_THROW(ChooseSettingsForClouds({&metres, &ten_times}, std::nullopt, 1));
+  EXPECT_NO_THROW(ChooseSettingsForClouds({metres, ten_times}, std::nullopt, 1));
   try {
-    ChooseSettingsForClouds({&millimetres, &metres}, std::nullopt, 1);
+    ChooseSettingsForClouds({millimetres, metres}, std::nullopt, 1);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("differ in scale by a factor of about 1000"));
     EXPECT_THAT(e.what(), HasSubstr("do they share units?"));
     EXPECT_THAT(e.what(), HasSubstr("--scale-source 0.001"));
   }
-  EXPECT_THROW(ChooseSettingsForClouds({&metres, &millimetres}, std::nullopt, 1), InputError);
+  EXPECT_THROW(ChooseSettingsForClouds({metres, millimetres}, std::nullopt, 1), InputError);
 }
 
 // 3 % of the camera's returns through a window, 60-150 m out in one
@@ -228,7 +228,7 @@ TEST(AutoSettings, TooSmallOrFlatCloudIsOneClearError) {
 
 TEST(AutoSettings, OnlyFieldsLeftAutomaticAreChosen) {
   const Points scan = StreetScan();
-  const ChosenSettings chosen = ChooseSettingsForClouds({&scan}, std::nullopt, 1);
+  const ChosenSettings chosen = ChooseSettingsForClouds({scan}, std::nullopt, 1);
   BoIcpConfig config = PresetConfig("C");
   config.voxel = 0.5;
   config.MarkSet("voxel");
@@ -249,7 +249,7 @@ TEST(AutoSettings, OnlyFieldsLeftAutomaticAreChosen) {
 
 TEST(AutoSettings, PresetsKeepTheirVoxelRatio) {
   const Points scan = StreetScan();
-  const ChosenSettings chosen = ChooseSettingsForClouds({&scan}, std::nullopt, 1);
+  const ChosenSettings chosen = ChooseSettingsForClouds({scan}, std::nullopt, 1);
   BoIcpConfig a = PresetConfig("A"), c = PresetConfig("C");
   ApplyChosenSettings(chosen, a);
   ApplyChosenSettings(chosen, c);

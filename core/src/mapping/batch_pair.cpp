@@ -46,11 +46,9 @@ BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoI
     clouds.push_back(std::move(loaded.points));
     choice.measured.push_back({index, 0});
   }
-  std::vector<const Points*> pointers;
-  for (const Points& cloud : clouds) pointers.push_back(&cloud);
   // Every loaded cloud is measured, in order (max_clouds = their number).
-  const ChosenSettings chosen =
-      ChooseSettingsForClouds(pointers, DeclareSensor(config.sensor, format), config.seed, count);
+  const ChosenSettings chosen = ChooseSettingsForClouds(
+      {clouds.begin(), clouds.end()}, DeclareSensor(config.sensor, format), config.seed, count);
   for (size_t k = 0; k < count; ++k) choice.measured[k].far_returns = chosen.far_returns[k];
   choice.sensor = chosen.sensor;
   choice.sensor_reason = chosen.sensor_reason;

@@ -234,8 +234,8 @@ FarReturnGate FarReturnGateOf(const Points& points) {
 
 // Median distance from a point to its nearest other point, over
 // kSpacingQueries random points (seeded) against the whole cloud.
-double PointSpacing(const Points& cloud, uint64_t seed) {
-  const NearestNeighborIndex tree(cloud, /*neighbour_lists=*/false,
+double PointSpacing(PointSpan cloud, uint64_t seed) {
+  const NearestNeighborIndex tree(cloud.ToPoints(), /*neighbour_lists=*/false,
                                   NearestNeighborIndex::kFewQueriesLeafSize);
   std::vector<double> gaps;
   std::vector<size_t> indices;
@@ -256,7 +256,7 @@ double RefineVoxel(double voxel, double spacing) {
 
 }  // namespace
 
-CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed) {
+CloudStatistics MeasureCloud(PointSpan cloud, uint64_t seed) {
   const std::string advice =
       " to choose settings from; give --voxel and --translation-bounds (or --fixed-settings)";
   if (cloud.size() < kMinPointsForSettings) {
@@ -355,7 +355,7 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats,
   return chosen;
 }
 
-ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
+ChosenSettings ChooseSettingsForClouds(const std::vector<PointSpan>& clouds,
                                        const std::optional<DeclaredSensor>& declared, uint64_t seed,
                                        size_t max_clouds, int threads) {
   if (clouds.empty()) throw InputError("automatic settings need at least one cloud");
@@ -363,7 +363,7 @@ ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
   std::vector<CloudStatistics> stats(count);
   ParallelFor(count, threads, [&](size_t k) {
     const size_t index = count == 1 ? 0 : k * (clouds.size() - 1) / (count - 1);
-    stats[k] = MeasureCloud(*clouds[index], seed + index);
+    stats[k] = MeasureCloud(clouds[index], seed + index);
   });
   return ChooseSettings(stats, declared);
 }
@@ -420,11 +420,11 @@ std::string DescribeSettings(const BoIcpConfig& config, const std::vector<std::s
   return text;
 }
 
-std::vector<std::string> ChooseSettingsForPair(const Points& source, const Points& target,
+std::vector<std::string> ChooseSettingsForPair(PointSpan source, PointSpan target,
                                                BoIcpConfig& config) {
   if (config.automatic.empty()) return {};
   return ApplyChosenSettings(
-      ChooseSettingsForClouds({&source, &target}, DeclareSensor(config.sensor, CloudFormat::kAuto),
+      ChooseSettingsForClouds({source, target}, DeclareSensor(config.sensor, CloudFormat::kAuto),
                               config.seed, 2, config.threads),
       config);
 }

@@ -13,7 +13,7 @@
 
 namespace boicp {
 
-Points CropByRange(const Points& points, double min_range, double max_range) {
+Points CropByRange(PointSpan points, double min_range, double max_range) {
   const double min_sq = min_range * min_range;
   const double max_sq = max_range > 0.0 ? max_range * max_range : -1.0;
   Points kept;
@@ -139,8 +139,8 @@ Points VoxelDownsample(const Points& points, double voxel, CellOrder order) {
   return centroids;
 }
 
-Points RandomSubsample(const Points& points, size_t max_points, uint64_t seed) {
-  if (max_points == 0 || max_points >= points.size()) return points;
+Points RandomSubsample(PointSpan points, size_t max_points, uint64_t seed) {
+  if (max_points == 0 || max_points >= points.size()) return points.ToPoints();
   std::vector<size_t> indices(points.size());
   std::iota(indices.begin(), indices.end(), size_t{0});
   std::mt19937_64 rng(seed);

@@ -63,7 +63,7 @@ CellOrder PyramidCellOrder(const BoIcpConfig& config) {
   return config.budget == Budget::kFixed ? CellOrder::kOpen3d : CellOrder::kFirstReached;
 }
 
-ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config) {
+ScanPyramid BuildScanPyramid(PointSpan raw, const BoIcpConfig& config) {
   ScanPyramid scan;
   scan.min_range = config.min_range;
   scan.max_range = config.max_range;

@@ -10,7 +10,7 @@
 namespace boicp {
 
 RegistrationResult RegistrationMethod::RegisterClouds(
-    const Points& source, const Points& target, const PairHints& hints,
+    PointSpan source, PointSpan target, const PairHints& hints,
     const RegistrationCallbacks& callbacks) const {
   const auto started = std::chrono::steady_clock::now();
   const std::shared_ptr<const PreparedScan> prepared_source = Prepare(source);
@@ -81,7 +81,7 @@ class PyramidMethod : public RegistrationMethod {
     ValidateConfig(config_);
   }
 
-  std::shared_ptr<const PreparedScan> Prepare(const Points& scan) const override {
+  std::shared_ptr<const PreparedScan> Prepare(PointSpan scan) const override {
     return std::make_shared<const PyramidScan>(BuildScanPyramid(scan, config_));
   }
 

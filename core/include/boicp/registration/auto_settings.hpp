@@ -11,6 +11,7 @@
 
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/config.hpp"
+#include "boicp/util/point_span.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -51,7 +52,7 @@ struct CloudStatistics {
 /// Measures `cloud` (metres, sensor frame). Random choices use `seed`.
 /// Throws InputError when the cloud has fewer than kMinPointsForSettings
 /// points or no extent, with a message that names the flags to give instead.
-CloudStatistics MeasureCloud(const Points& cloud, uint64_t seed);
+CloudStatistics MeasureCloud(PointSpan cloud, uint64_t seed);
 
 constexpr size_t kMinPointsForSettings = 100;
 
@@ -82,7 +83,7 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats,
 /// come from a few scans, so that every pair of it shares them), and chooses;
 /// the clouds are measured on up to `threads` threads at once, which does not
 /// change the choice.
-ChosenSettings ChooseSettingsForClouds(const std::vector<const Points*>& clouds,
+ChosenSettings ChooseSettingsForClouds(const std::vector<PointSpan>& clouds,
                                        const std::optional<DeclaredSensor>& declared, uint64_t seed,
                                        size_t max_clouds = 5, int threads = 1);
 
@@ -96,7 +97,7 @@ std::vector<std::string> ApplyChosenSettings(const ChosenSettings& chosen, BoIcp
 /// (the sensor as config.sensor says, else from their geometry), as
 /// RegisterPair does, and returns their names (ApplyChosenSettings). Throws
 /// InputError for clouds too small to choose from.
-std::vector<std::string> ChooseSettingsForPair(const Points& source, const Points& target,
+std::vector<std::string> ChooseSettingsForPair(PointSpan source, PointSpan target,
                                                BoIcpConfig& config);
 
 /// One line for the user: preset, search mode, the sensor and why, and the

@@ -3,13 +3,14 @@
 
 #include <cstdint>
 
+#include "boicp/util/point_span.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
 
 /// Keeps points whose distance from the sensor origin lies in [min_range,
 /// max_range] metres. max_range <= 0 means no upper limit.
-Points CropByRange(const Points& points, double min_range, double max_range);
+Points CropByRange(PointSpan points, double min_range, double max_range);
 
 /// The order in which VoxelDownsample returns its cells.
 enum class CellOrder {
@@ -31,7 +32,7 @@ Points VoxelDownsample(const Points& points, double voxel,
 /// At most `max_points` points chosen uniformly without replacement, in their
 /// original order; reproducible for a given seed. max_points == 0 or
 /// max_points >= size returns the input unchanged.
-Points RandomSubsample(const Points& points, size_t max_points, uint64_t seed);
+Points RandomSubsample(PointSpan points, size_t max_points, uint64_t seed);
 
 /// Mean of the points (zero for an empty input).
 Point Centroid(const Points& points);

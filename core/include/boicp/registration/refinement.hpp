@@ -55,7 +55,7 @@ CellOrder PyramidCellOrder(const BoIcpConfig& config);
 
 /// `raw` cropped and downsampled at every one of PyramidVoxels(config), the
 /// levels built on config.threads threads.
-ScanPyramid BuildScanPyramid(const Points& raw, const BoIcpConfig& config);
+ScanPyramid BuildScanPyramid(PointSpan raw, const BoIcpConfig& config);
 
 /// Both clouds of a pair at the search voxel and at every refinement level,
 /// built once per pair. Each cloud is centred (ScanPyramid): a point p of the

@@ -13,6 +13,7 @@
 
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/config.hpp"
+#include "boicp/util/point_span.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -48,7 +49,7 @@ class RegistrationMethod {
   /// Depends on the settings but not on the seed, so a method built for
   /// another pair of the batch registers it too. Throws InputError when
   /// cropping leaves nothing to register.
-  virtual std::shared_ptr<const PreparedScan> Prepare(const Points& scan) const = 0;
+  virtual std::shared_ptr<const PreparedScan> Prepare(PointSpan scan) const = 0;
 
   /// Registers `source` onto `target`, both prepared by a method of this
   /// name and settings. result.transform is T_target_source. Throws
@@ -60,8 +61,7 @@ class RegistrationMethod {
                                       const RegistrationCallbacks& callbacks = {}) const = 0;
 
   /// Prepare, then Register; runtime_s covers both.
-  RegistrationResult RegisterClouds(const Points& source, const Points& target,
-                                    const PairHints& hints = {},
+  RegistrationResult RegisterClouds(PointSpan source, PointSpan target, const PairHints& hints = {},
                                     const RegistrationCallbacks& callbacks = {}) const;
 };
 

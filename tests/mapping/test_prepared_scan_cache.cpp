@@ -64,7 +64,7 @@ class PreparedScanCacheTest : public ::testing::Test {
 class CountingMethod final : public RegistrationMethod {
  public:
   std::string Describe() const override { return "counts preparations"; }
-  std::shared_ptr<const PreparedScan> Prepare(const Points& scan) const override {
+  std::shared_ptr<const PreparedScan> Prepare(PointSpan scan) const override {
     ++prepared;
     return std::make_shared<const Counted>(scan.size());
   }
