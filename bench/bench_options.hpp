@@ -12,7 +12,7 @@
 
 #include <Eigen/Core>
 
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 #include "field_conditions.hpp"
 
 namespace boicp::bench {

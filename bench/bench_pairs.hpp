@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "boicp/registration/evaluation.hpp"
 #include "boicp/util/types.hpp"
 #include "dataset_table.hpp"
+#include "evaluation.hpp"
 
 namespace boicp::bench {
 

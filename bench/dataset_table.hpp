@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 
 #include "bench_options.hpp"
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 
 namespace boicp::bench {
 

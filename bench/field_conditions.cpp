@@ -4,7 +4,7 @@
 #include <random>
 #include <utility>
 
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/preprocess.hpp"
 
 namespace boicp::bench {
 namespace {

@@ -11,8 +11,8 @@
 #include <limits>
 #include <vector>
 
-#include "boicp/registration/alignment_score.hpp"
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/alignment_score.hpp"
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/search_space.hpp"
 #include "boicp/util/parallel_for.hpp"

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "boicp/registration/evaluation.hpp"
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/preprocess.hpp"
+#include "evaluation.hpp"
 
 namespace boicp::bench {
 

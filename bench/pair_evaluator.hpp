@@ -2,7 +2,7 @@
 // Accuracy of an estimated transform on one benchmark pair.
 
 #include "bench_pairs.hpp"
-#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
 
 namespace boicp::bench {
 

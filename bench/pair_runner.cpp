@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <functional>
 
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 
 namespace boicp::bench {
 namespace {

@@ -40,7 +40,7 @@ void JobManager::Start() {
     if (job.cancel_requested()) {
       // Cancelled while a previous daemon ran it: finish the cancellation.
       job.set_state(v1::JOB_STATE_CANCELLED);
-      job.set_stage("cancelled");
+      rpc::SetJobStage(job, v1::JOB_STAGE_CANCELLED);
       job.set_finished_at(rpc::NowSeconds());
       store_.UpdateJob(job);
       Publish(job);
@@ -50,7 +50,7 @@ void JobManager::Start() {
     if (store_.UnendedRuns(job.job_id()) >= kMaxUnendedRuns) {
       // Resuming it again would most likely take this daemon down as well.
       job.set_state(v1::JOB_STATE_FAILED);
-      job.set_stage("failed");
+      rpc::SetJobStage(job, v1::JOB_STAGE_FAILED);
       job.set_error(
           "boicpd stopped unexpectedly (killed, perhaps for memory) in each of its last " +
           std::to_string(kMaxUnendedRuns) + " runs of this job; it is not resumed again");
@@ -132,7 +132,7 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   v1::Job job;
   job.set_label(request.label());
   job.set_state(v1::JOB_STATE_QUEUED);
-  job.set_stage("queued");
+  rpc::SetJobStage(job, v1::JOB_STAGE_QUEUED);
   job.set_num_scans(static_cast<uint32_t>(request.scan_ids_size()));
   // A keyframe plan registers at least one pair per scan after the first.
   const size_t planned = (batch.plan.keyframes ? batch.scans.size() - 1 : batch.plan.chain.size()) +
@@ -156,7 +156,7 @@ v1::Job JobManager::Cancel(const std::string& job_id) {
   if (const auto queued = std::find(queue_.begin(), queue_.end(), job_id); queued != queue_.end()) {
     queue_.erase(queued);
     job->set_state(v1::JOB_STATE_CANCELLED);
-    job->set_stage("cancelled");
+    rpc::SetJobStage(*job, v1::JOB_STAGE_CANCELLED);
     job->set_cancel_requested(true);
     job->set_finished_at(rpc::NowSeconds());
     job->set_eta_seconds(-1.0);

@@ -109,7 +109,7 @@ class JobRun : public MapProgressSink {
       control_.SetDeadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                               std::chrono::duration<double>(std::max(left, 0.0))));
     }
-    job_.set_stage(MapStageName(MapStage::kRegistering));
+    rpc::SetJobStage(job_, rpc::JobStageOf(MapStage::kRegistering));
     job_.set_eta_seconds(-1.0);
   }
 
@@ -177,7 +177,7 @@ class JobRun : public MapProgressSink {
   }
 
   void StageStarted(MapStage stage, int total) override {
-    SetStage(MapStageName(stage), 0, static_cast<uint32_t>(total));
+    SetStage(stage, 0, static_cast<uint32_t>(total));
   }
 
   // The pipeline's hook before fusion (MapPipelineHooks).
@@ -189,9 +189,9 @@ class JobRun : public MapProgressSink {
   }
 
   void AssemblyStep(const AssemblyProgress& p) override {
-    const std::string stage = MapStageName(p.stage);
-    const bool new_stage = stage != job_.stage();
-    if (new_stage) job_.set_stage(stage);
+    const v1::JobStage stage = rpc::JobStageOf(p.stage);
+    const bool new_stage = stage != job_.stage_code();
+    if (new_stage) rpc::SetJobStage(job_, stage);
     job_.set_stage_done(static_cast<uint32_t>(p.done));
     job_.set_stage_total(static_cast<uint32_t>(p.total));
     if (p.stage == MapStage::kFusing && p.done > 0) {
@@ -217,7 +217,7 @@ class JobRun : public MapProgressSink {
   // Pairs finish at the rate seen so far in this run; the ETA counts down
   // between completions.
   void UpdateEta() {
-    if (done_this_run_ == 0 || job_.stage() != MapStageName(MapStage::kRegistering)) return;
+    if (done_this_run_ == 0 || job_.stage_code() != v1::JOB_STAGE_REGISTERING) return;
     const double per_pair =
         std::chrono::duration<double>(last_done_ - run_start_).count() / done_this_run_;
     const double remaining =
@@ -232,8 +232,8 @@ class JobRun : public MapProgressSink {
     Publish(nullptr);
   }
 
-  void SetStage(const std::string& stage, uint32_t done, uint32_t total) {
-    job_.set_stage(stage);
+  void SetStage(MapStage stage, uint32_t done, uint32_t total) {
+    rpc::SetJobStage(job_, rpc::JobStageOf(stage));
     job_.set_stage_done(done);
     job_.set_stage_total(total);
     job_.set_eta_seconds(-1.0);
@@ -282,7 +282,9 @@ class JobRun : public MapProgressSink {
 
   RunOutcome End(v1::JobState state, const std::string& error) {
     job_.set_state(state);
-    job_.set_stage(state == v1::JOB_STATE_SUCCEEDED ? "done" : rpc::JobStateName(state));
+    rpc::SetJobStage(job_, state == v1::JOB_STATE_SUCCEEDED ? v1::JOB_STAGE_DONE
+                           : state == v1::JOB_STATE_FAILED  ? v1::JOB_STAGE_FAILED
+                                                            : v1::JOB_STAGE_CANCELLED);
     job_.set_error(WithoutServerPaths(error));  // the log below keeps the whole message
     job_.set_finished_at(rpc::NowSeconds());
     job_.set_eta_seconds(state == v1::JOB_STATE_SUCCEEDED ? 0.0 : -1.0);

@@ -62,6 +62,15 @@ Message Parse(const std::string& bytes, const char* what) {
   return message;
 }
 
+// Jobs stored before stage_code existed carry only the stage's name.
+v1::Job ParseJob(const std::string& bytes) {
+  v1::Job job = Parse<v1::Job>(bytes, "job");
+  if (job.stage_code() == v1::JOB_STAGE_UNSPECIFIED) {
+    job.set_stage_code(rpc::JobStageFromName(job.stage()));
+  }
+  return job;
+}
+
 std::string InformationBytes(const InformationMatrix& information) {
   std::string bytes(sizeof(double) * 36, '\0');
   std::memcpy(bytes.data(), information.data(), bytes.size());
@@ -282,7 +291,7 @@ std::vector<std::string> JobStore::JobsFinishedBefore(double cutoff) {
   std::vector<std::string> ids;
   auto stmt = db_.Prepare("SELECT job FROM jobs");
   while (stmt.Step()) {
-    const auto job = Parse<v1::Job>(stmt.ColumnBlob(0), "job");
+    const auto job = ParseJob(stmt.ColumnBlob(0));
     if (rpc::IsTerminal(job.state()) && job.finished_at() < cutoff) ids.push_back(job.job_id());
   }
   return ids;
@@ -320,7 +329,7 @@ std::optional<v1::Job> JobStore::ReadJob(const std::string& job_id) {
   auto stmt = db_.Prepare("SELECT job FROM jobs WHERE job_id = ?1");
   stmt.Bind(1, job_id);
   if (!stmt.Step()) return std::nullopt;
-  return Parse<v1::Job>(stmt.ColumnBlob(0), "job");
+  return ParseJob(stmt.ColumnBlob(0));
 }
 
 void JobStore::WriteJob(const v1::Job& job) {
@@ -369,7 +378,7 @@ JobPage JobStore::ListJobs(int page_size, const std::string& page_token) {
       break;
     }
     last_seq = stmt.ColumnInt(0);
-    page.jobs.push_back(Parse<v1::Job>(stmt.ColumnBlob(1), "job"));
+    page.jobs.push_back(ParseJob(stmt.ColumnBlob(1)));
   }
   return page;
 }
@@ -380,7 +389,7 @@ std::vector<v1::Job> JobStore::UnfinishedJobs() {
   stmt.Bind(1, static_cast<int64_t>(v1::JOB_STATE_QUEUED))
       .Bind(2, static_cast<int64_t>(v1::JOB_STATE_RUNNING));
   std::vector<v1::Job> jobs;
-  while (stmt.Step()) jobs.push_back(Parse<v1::Job>(stmt.ColumnBlob(0), "job"));
+  while (stmt.Step()) jobs.push_back(ParseJob(stmt.ColumnBlob(0)));
   return jobs;
 }
 

@@ -1,6 +1,7 @@
 #include "boicp/rpc/proto_convert.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <iterator>
@@ -202,6 +203,28 @@ std::string AnsweredBy(const v1::PairResult& pair) {
 bool IsTerminal(v1::JobState state) {
   return state == v1::JOB_STATE_SUCCEEDED || state == v1::JOB_STATE_FAILED ||
          state == v1::JOB_STATE_CANCELLED;
+}
+
+namespace {
+constexpr const char kStagePrefix[] = "JOB_STAGE_";
+}  // namespace
+
+void SetJobStage(v1::Job& job, v1::JobStage stage) {
+  job.set_stage_code(stage);
+  std::string name = v1::JobStage_Name(stage).substr(sizeof(kStagePrefix) - 1);
+  std::transform(name.begin(), name.end(), name.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  job.set_stage(name);
+}
+
+v1::JobStage JobStageOf(MapStage stage) { return JobStageFromName(MapStageName(stage)); }
+
+v1::JobStage JobStageFromName(const std::string& name) {
+  std::string upper = kStagePrefix + name;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  v1::JobStage stage = v1::JOB_STAGE_UNSPECIFIED;
+  return v1::JobStage_Parse(upper, &stage) ? stage : v1::JOB_STAGE_UNSPECIFIED;
 }
 
 std::string JobStateName(v1::JobState state) {

@@ -12,10 +12,10 @@
 #include <octomap/OcTree.h>
 
 #include "../support/files_and_processes.hpp"
+#include "boicp/icp/voxel_cloud.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/mapping/map_assembly.hpp"
-#include "boicp/registration/voxel_cloud.hpp"
 
 namespace boicp {
 namespace {

@@ -6,7 +6,7 @@
 
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/mapping/pose_graph.hpp"
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 
 namespace boicp {
 namespace {

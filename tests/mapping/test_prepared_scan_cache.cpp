@@ -20,9 +20,9 @@
 #include "boicp/mapping/batch_pair.hpp"
 #include "boicp/mapping/prepared_scan_cache.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/evaluation.hpp"
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/registration_method.hpp"
+#include "evaluation.hpp"
 
 namespace boicp {
 namespace {

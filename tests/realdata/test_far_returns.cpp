@@ -13,7 +13,7 @@
 
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/auto_settings.hpp"
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 #include "field_conditions.hpp"
 #include "shared_data.hpp"
 

@@ -14,10 +14,10 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/icp/icp.hpp"
 #include "boicp/io/point_cloud_io.hpp"
-#include "boicp/registration/evaluation.hpp"
-#include "boicp/registration/icp.hpp"
 #include "boicp/registration/refinement.hpp"
+#include "evaluation.hpp"
 #include "shared_data.hpp"
 
 namespace boicp {

@@ -18,7 +18,7 @@
 #include "../support/files_and_processes.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 #include "shared_data.hpp"
 
 namespace boicp {

@@ -16,7 +16,7 @@
 
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 #include "field_conditions.hpp"
 #include "shared_data.hpp"
 

@@ -15,7 +15,8 @@
 #include "../support/demo_sequence.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/trajectory_io.hpp"
-#include "boicp/registration/evaluation.hpp"
+#include "boicp/rpc/proto_convert.hpp"
+#include "evaluation.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::test {
@@ -139,6 +140,7 @@ TEST_F(EndToEnd, BatchToOctomapAndTrajectory) {
     EXPECT_GE(event.job().pairs_done(), last_done);
     last_done = event.job().pairs_done();
     stages.insert(event.job().stage());
+    EXPECT_EQ(rpc::JobStageFromName(event.job().stage()), event.job().stage_code());
     if (event.has_pair()) streamed.push_back(event.pair());
   });
   ASSERT_EQ(done.state(), v1::JOB_STATE_SUCCEEDED) << done.error();

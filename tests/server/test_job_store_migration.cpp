@@ -1,6 +1,7 @@
 // A database written before the job store's later columns existed (a job's
 // unended runs, the rung that answered a pair) still opens, is brought to
 // the current schema version, and its rows read the columns' defaults; a
+// job stored before Job.stage_code gets it from its stage's name; a
 // database of a newer version is refused.
 
 #include <unistd.h>
@@ -55,6 +56,7 @@ void WriteFirstReleaseDatabase(const std::string& path) {
   v1::Job job;
   job.set_job_id(kJobId);
   job.set_state(v1::JOB_STATE_RUNNING);
+  job.set_stage("fusing");  // the name alone, as before stage_code
   db.Prepare("INSERT INTO jobs (seq, job_id, state, job, request) VALUES (1, ?1, ?2, ?3, '')")
       .Bind(1, std::string(kJobId))
       .Bind(2, static_cast<int64_t>(job.state()))
@@ -99,6 +101,10 @@ TEST_F(JobStoreMigration, AFirstReleaseDatabaseOpensWithTheColumnsDefaults) {
     EXPECT_EQ(pairs[0].result.answered_by(), "full-search");
     EXPECT_EQ(store.UnendedRuns(kJobId), 0);
     EXPECT_EQ(store.BeginRun(kJobId), 1);
+    const std::optional<v1::Job> job = store.GetJob(kJobId);
+    ASSERT_TRUE(job.has_value());
+    EXPECT_EQ(job->stage_code(), v1::JOB_STAGE_FUSING);
+    EXPECT_EQ(job->stage(), "fusing");
 
     v1::PairResult next = Result(1, 0.5);
     next.set_answered_by("prior");

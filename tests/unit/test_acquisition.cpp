@@ -1,11 +1,11 @@
-#include "boicp/registration/acquisition.hpp"
+#include "boicp/bo/acquisition.hpp"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -1,4 +1,4 @@
-#include "boicp/registration/bayes_opt.hpp"
+#include "boicp/bo/bayes_opt.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

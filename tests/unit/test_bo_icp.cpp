@@ -7,11 +7,11 @@
 #include <limits>
 #include <random>
 
+#include "boicp/icp/icp.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/evaluation.hpp"
-#include "boicp/registration/icp.hpp"
 #include "boicp/registration/refinement.hpp"
+#include "evaluation.hpp"
 
 namespace boicp {
 namespace {

@@ -10,11 +10,11 @@
 #include <random>
 #include <vector>
 
+#include "boicp/icp/preprocess.hpp"
+#include "boicp/icp/surface_normals.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/feature_hypotheses.hpp"
 #include "boicp/registration/fpfh_features.hpp"
-#include "boicp/registration/preprocess.hpp"
-#include "boicp/registration/surface_normals.hpp"
 
 namespace boicp {
 namespace {

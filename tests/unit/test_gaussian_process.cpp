@@ -1,4 +1,4 @@
-#include "boicp/registration/gaussian_process.hpp"
+#include "boicp/bo/gaussian_process.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 
 namespace boicp {
 namespace {

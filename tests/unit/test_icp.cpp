@@ -3,12 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/icp/alignment_score.hpp"
+#include "boicp/icp/icp.hpp"
+#include "boicp/icp/preprocess.hpp"
+#include "boicp/icp/surface_normals.hpp"
 #include "boicp/io/synthetic_scene.hpp"
-#include "boicp/registration/alignment_score.hpp"
-#include "boicp/registration/icp.hpp"
-#include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/search_space.hpp"
-#include "boicp/registration/surface_normals.hpp"
 
 namespace boicp {
 namespace {

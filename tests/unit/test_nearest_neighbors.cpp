@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "boicp/icp/nearest_neighbors.hpp"
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/io/synthetic_scene.hpp"
-#include "boicp/registration/nearest_neighbors.hpp"
-#include "boicp/registration/preprocess.hpp"
 
 namespace boicp {
 namespace {

@@ -5,11 +5,11 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "boicp/icp/pair_information.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/evaluation.hpp"
-#include "boicp/registration/pair_information.hpp"
 #include "boicp/registration/refinement.hpp"
+#include "evaluation.hpp"
 
 namespace boicp {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/auto_settings.hpp"
-#include "boicp/registration/preprocess.hpp"
 #include "boicp/util/point_span.hpp"
 
 namespace boicp {

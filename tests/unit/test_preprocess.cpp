@@ -9,9 +9,9 @@
 #include <gtest/gtest.h>
 #include <open3d/geometry/PointCloud.h>
 
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/synthetic_scene.hpp"
-#include "boicp/registration/preprocess.hpp"
 
 namespace boicp {
 namespace {

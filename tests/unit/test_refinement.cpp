@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/io/synthetic_scene.hpp"
-#include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/refinement.hpp"
 
 namespace boicp {

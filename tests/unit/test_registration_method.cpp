@@ -9,8 +9,8 @@
 #include <memory>
 
 #include "boicp/io/synthetic_scene.hpp"
-#include "boicp/registration/evaluation.hpp"
 #include "boicp/registration/registration_method.hpp"
+#include "evaluation.hpp"
 
 namespace boicp {
 namespace {

@@ -5,8 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include "boicp/icp/voxel_cloud.hpp"
 #include "boicp/io/trajectory_io.hpp"
-#include "boicp/registration/voxel_cloud.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "boicp/util/parallel_for.hpp"
 

@@ -6,8 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "boicp/icp/surface_normals.hpp"
 #include "boicp/registration/auto_settings.hpp"
-#include "boicp/registration/surface_normals.hpp"
 
 namespace boicp {
 namespace {

@@ -7,8 +7,8 @@
 #include <random>
 #include <string>
 
-#include "boicp/registration/nearest_neighbors.hpp"
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "util/percentile.hpp"
 

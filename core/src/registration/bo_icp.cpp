@@ -9,14 +9,14 @@
 #include <stdexcept>
 #include <utility>
 
+#include "boicp/icp/nearest_neighbors.hpp"
+#include "boicp/icp/preprocess.hpp"
+#include "boicp/icp/surface_normals.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/feature_hypotheses.hpp"
 #include "boicp/registration/fpfh_features.hpp"
-#include "boicp/registration/nearest_neighbors.hpp"
-#include "boicp/registration/preprocess.hpp"
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/search_space.hpp"
-#include "boicp/registration/surface_normals.hpp"
 #include "staged_search.hpp"
 
 namespace boicp {

@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "boicp/registration/preprocess.hpp"
-#include "boicp/registration/surface_normals.hpp"
+#include "boicp/icp/preprocess.hpp"
+#include "boicp/icp/surface_normals.hpp"
 #include "boicp/util/parallel_for.hpp"
 
 namespace boicp {

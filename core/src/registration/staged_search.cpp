@@ -4,9 +4,9 @@
 #include <mutex>
 #include <utility>
 
-#include "boicp/registration/alignment_score.hpp"
-#include "boicp/registration/icp.hpp"
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/alignment_score.hpp"
+#include "boicp/icp/icp.hpp"
+#include "boicp/icp/preprocess.hpp"
 
 namespace boicp {
 namespace {

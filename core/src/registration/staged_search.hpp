@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "boicp/registration/bayes_opt.hpp"
+#include "boicp/bo/bayes_opt.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/search_space.hpp"

@@ -7,9 +7,9 @@
 
 #include <Eigen/Core>
 
+#include "boicp/icp/pair_information.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/registration/bo_icp.hpp"
-#include "boicp/registration/pair_information.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "boicp/icp/pair_information.hpp"
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/config.hpp"
-#include "boicp/registration/pair_information.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "boicp/registration/bayes_opt.hpp"
+#include "boicp/bo/bayes_opt.hpp"
 
 namespace boicp {
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

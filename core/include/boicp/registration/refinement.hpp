@@ -8,11 +8,11 @@
 #include <optional>
 #include <vector>
 
-#include "boicp/registration/alignment_score.hpp"
+#include "boicp/icp/alignment_score.hpp"
+#include "boicp/icp/icp.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/registration/config.hpp"
-#include "boicp/registration/icp.hpp"
-#include "boicp/registration/nearest_neighbors.hpp"
-#include "boicp/registration/preprocess.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -8,6 +8,7 @@
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/mapping/batch_pairing.hpp"
 #include "boicp/mapping/map_assembly.hpp"
+#include "boicp/mapping/map_stage.hpp"
 #include "boicp/util/types.hpp"
 #include "boicp/v1/map_builder.pb.h"
 
@@ -60,6 +61,14 @@ std::string AnsweredBy(const v1::PairResult& pair);
 bool IsTerminal(v1::JobState state);
 /// "queued", "running", "succeeded", "failed", "cancelled" ("unspecified" otherwise).
 std::string JobStateName(v1::JobState state);
+
+/// Sets the job's stage_code and, from it, its stage name ("fusing").
+void SetJobStage(v1::Job& job, v1::JobStage stage);
+/// The stage a map stage is in the API.
+v1::JobStage JobStageOf(MapStage stage);
+/// The stage named `name` ("queued", "fusing", ...); JOB_STAGE_UNSPECIFIED
+/// for another name. Jobs stored before stage_code existed get it from here.
+v1::JobStage JobStageFromName(const std::string& name);
 
 /// Seconds since the Unix epoch, for the *_at fields.
 double NowSeconds();

@@ -1,4 +1,4 @@
-#include "boicp/registration/acquisition.hpp"
+#include "boicp/bo/acquisition.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include <nlopt.hpp>
 
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "boicp/util/types.hpp"
 

@@ -1,4 +1,4 @@
-#include "boicp/registration/pair_information.hpp"
+#include "boicp/icp/pair_information.hpp"
 
 namespace boicp {
 

@@ -1,4 +1,4 @@
-#include "boicp/registration/surface_normals.hpp"
+#include "boicp/icp/surface_normals.hpp"
 
 #include <vector>
 

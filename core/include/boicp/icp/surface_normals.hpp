@@ -2,7 +2,7 @@
 // Surface normals of a fixed target cloud, estimated once per pair, for
 // point-to-plane ICP.
 
-#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

@@ -9,8 +9,8 @@
 
 #include <Eigen/Core>
 
-#include "boicp/registration/acquisition.hpp"
-#include "boicp/registration/gaussian_process.hpp"
+#include "boicp/bo/acquisition.hpp"
+#include "boicp/bo/gaussian_process.hpp"
 
 namespace boicp {
 

@@ -1,4 +1,4 @@
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 
 #include <cstdint>
 #include <numeric>

@@ -1,4 +1,4 @@
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/preprocess.hpp"
 
 #include <algorithm>
 #include <cmath>

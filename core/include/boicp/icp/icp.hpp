@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

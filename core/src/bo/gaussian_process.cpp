@@ -1,4 +1,4 @@
-#include "boicp/registration/gaussian_process.hpp"
+#include "boicp/bo/gaussian_process.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include <nlopt.hpp>
 
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

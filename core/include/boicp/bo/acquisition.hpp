@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-#include "boicp/registration/gaussian_process.hpp"
+#include "boicp/bo/gaussian_process.hpp"
 
 namespace boicp {
 

@@ -1,4 +1,4 @@
-#include "boicp/registration/alignment_score.hpp"
+#include "boicp/icp/alignment_score.hpp"
 
 #include <algorithm>
 #include <cmath>

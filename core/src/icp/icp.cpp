@@ -1,4 +1,4 @@
-#include "boicp/registration/icp.hpp"
+#include "boicp/icp/icp.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
-#include "boicp/registration/preprocess.hpp"
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/util/parallel_for.hpp"
 
 namespace boicp {

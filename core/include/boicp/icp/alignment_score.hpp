@@ -1,7 +1,7 @@
 #pragma once
 // How well a transformed source cloud lies on the target cloud.
 
-#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {

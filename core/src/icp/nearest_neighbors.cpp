@@ -1,4 +1,4 @@
-#include "boicp/registration/nearest_neighbors.hpp"
+#include "boicp/icp/nearest_neighbors.hpp"
 
 #include <algorithm>
 #include <array>

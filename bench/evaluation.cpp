@@ -1,4 +1,4 @@
-#include "boicp/registration/evaluation.hpp"
+#include "evaluation.hpp"
 
 #include <cmath>
 #include <filesystem>

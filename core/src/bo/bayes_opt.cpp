@@ -1,4 +1,4 @@
-#include "boicp/registration/bayes_opt.hpp"
+#include "boicp/bo/bayes_opt.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "boicp/registration/sampling.hpp"
+#include "boicp/bo/sampling.hpp"
 #include "boicp/util/parallel_for.hpp"
 #include "boicp/util/types.hpp"
 

@@ -1,4 +1,4 @@
-#include "boicp/registration/voxel_cloud.hpp"
+#include "boicp/icp/voxel_cloud.hpp"
 
 #include <algorithm>
 #include <cmath>
