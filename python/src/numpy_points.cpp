@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -67,12 +68,14 @@ ArrayPoints::ArrayPoints(const py::array& array, const std::string& what) : arra
 }
 
 py::array_t<double> ArrayFromPoints(Points points) {
-  auto* owned = new Points(std::move(points));
-  const py::capsule free_when_done(owned, [](void* p) { delete static_cast<Points*>(p); });
+  auto owned = std::make_unique<Points>(std::move(points));
   const auto rows = static_cast<py::ssize_t>(owned->size());
+  const double* xyz = owned->empty() ? nullptr : owned->front().data();
+  const py::capsule free_when_done(owned.get(), [](void* p) { delete static_cast<Points*>(p); });
+  owned.release();  // the capsule owns the points now
   constexpr auto kRow = static_cast<py::ssize_t>(sizeof(Point));
-  return py::array_t<double>({rows, py::ssize_t{3}}, {kRow, py::ssize_t{sizeof(double)}},
-                             owned->empty() ? nullptr : owned->front().data(), free_when_done);
+  return py::array_t<double>({rows, py::ssize_t{3}}, {kRow, py::ssize_t{sizeof(double)}}, xyz,
+                             free_when_done);
 }
 
 Transform TransformFromArray(const py::array& array, const std::string& what) {
