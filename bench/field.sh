@@ -11,6 +11,8 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${BIN:-$ROOT/build/bin/boicp-bench}"
+# Open3D's OpenMP threads sleep while they wait, as in bench/run.sh.
+export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}"
 [ $# -ge 1 ] || { sed -n '2,10p' "$0"; exit 2; }
 OUT="$1"; shift
 METHODS="bo-C-auto,bo-C"

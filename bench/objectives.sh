@@ -18,6 +18,8 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SEEDS="20230301 14 15"
 OUT=/tmp/boicp-objectives
 BIN="$ROOT/build/bin/boicp-bench"
+# Open3D's OpenMP threads sleep while they wait, as in bench/run.sh.
+export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}"
 DATA_ROOT="$ROOT/../shared/data"
 while [ $# -gt 0 ]; do
   case "$1" in

@@ -13,7 +13,7 @@ PACKAGES=(
   build-essential cmake pkg-config git ca-certificates
   libopen3d-dev libeigen3-dev liboctomap-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libssl-dev openssl
-  libspdlog-dev libfmt-dev libnlopt-cxx-dev libsqlite3-dev libtbb-dev
+  libspdlog-dev libfmt-dev libnlopt-cxx-dev libsqlite3-dev libsqlitecpp-dev libtbb-dev
   libnanoflann-dev libcli11-dev nlohmann-json3-dev libpng-dev
   librosbag-storage-dev libzstd-dev liblz4-dev
   libgtest-dev libgmock-dev libbenchmark-dev

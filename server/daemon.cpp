@@ -64,10 +64,11 @@ Daemon::Daemon(const DaemonOptions& options) : options_(options) {
   pace.min_bytes_per_s = options_.min_upload_kib_per_s << 10;
   pace.rate_grace = std::chrono::seconds(options_.upload_rate_grace_s);
   upload_watchdog_ = std::make_unique<UploadWatchdog>(pace);
+  upload_threads_ = std::make_unique<ThreadPool>(options_.max_concurrent_uploads);
   service_ = std::make_unique<MapBuilderService>(
       ServiceDeps{*store_, *data_dir_, *manager_, *watches_, auth_, *uploads_, *upload_watchdog_,
-                  options_.max_scan_bytes, options_.max_scan_points, min_free_bytes,
-                  max_stored_bytes, decode_budget_.get()});
+                  *upload_threads_, options_.max_scan_bytes, options_.max_scan_points,
+                  min_free_bytes, max_stored_bytes, decode_budget_.get()});
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

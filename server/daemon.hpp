@@ -51,6 +51,7 @@ class Daemon {
   std::unique_ptr<JobManager> manager_;
   std::unique_ptr<UploadBudget> uploads_;
   std::unique_ptr<UploadWatchdog> upload_watchdog_;  // outlives the server: its uploads leave it
+  std::unique_ptr<ThreadPool> upload_threads_;       // outlives the server: uploads finish on it
   std::unique_ptr<MapBuilderService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::string address_;

@@ -72,7 +72,8 @@ void AddDaemonOptions(CLI::App& app, DaemonOptions& o) {
       ->capture_default_str()
       ->envname("BOICPD_MIN_FREE_MB");
   app.add_option("--max-concurrent-uploads", o.max_concurrent_uploads,
-                 "Uploads streaming at once; more is RESOURCE_EXHAUSTED")
+                 "Uploads streaming at once (each has a thread to parse and store its scan); "
+                 "more is RESOURCE_EXHAUSTED")
       ->capture_default_str()
       ->envname("BOICPD_MAX_CONCURRENT_UPLOADS");
   app.add_option("--max-upload-bytes-in-flight", o.max_upload_bytes_in_flight,

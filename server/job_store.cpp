@@ -126,26 +126,37 @@ std::string JobIdForSeq(int64_t seq) {
 
 }  // namespace
 
-JobStore::JobStore(const std::string& path) : db_(path) {
-  // WAL lets readers run beside the writer; FULL syncs every commit, so an
-  // acknowledged upload or finished pair survives even a power cut.
-  db_.Exec("PRAGMA journal_mode=WAL");
-  db_.Exec("PRAGMA synchronous=FULL");
-  db_.Exec("PRAGMA foreign_keys=ON");
-  db_.Exec(kSchema);
-  Migrate();
+JobStore::JobStore(const std::string& path) : db_(OpenDatabase(path)) {
+  Locked([&] {
+    // WAL lets readers run beside the writer; FULL syncs every commit, so an
+    // acknowledged upload or finished pair survives even a power cut.
+    db_.exec("PRAGMA journal_mode=WAL");
+    db_.exec("PRAGMA synchronous=FULL");
+    db_.exec("PRAGMA foreign_keys=ON");
+    db_.exec(kSchema);
+    Migrate();
+  });
+}
+
+template <typename Work>
+auto JobStore::Locked(Work&& work) -> decltype(work()) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    return work();
+  } catch (const SQLite::Exception& e) {
+    RethrowSqliteError(e);
+  }
 }
 
 void JobStore::Migrate() {
-  auto read = db_.Prepare("PRAGMA user_version");
-  const int64_t version = read.Step() ? read.ColumnInt(0) : 0;
+  const int64_t version = db_.execAndGet("PRAGMA user_version").getInt64();
   if (version > kSchemaVersion) {
     throw std::runtime_error("data store: its schema version " + std::to_string(version) +
                              " is newer than this boicpd reads (" + std::to_string(kSchemaVersion) +
                              "); run the boicpd that wrote it, or use another --data-dir");
   }
   if (version == kSchemaVersion) return;
-  SqliteDatabase::Transaction transaction(db_);
+  SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
   // Version 0: databases from before the version was recorded, which may
   // lack the columns added since the first release. Older rows read their
   // defaults: no unended runs, answered by the full search, as every pair
@@ -153,204 +164,189 @@ void JobStore::Migrate() {
   AddMissingColumn("jobs", "unended_runs", "INTEGER NOT NULL DEFAULT 0");
   AddMissingColumn("pair_results", "answered_by", "TEXT NOT NULL DEFAULT 'full-search'");
   AddMissingColumn("scans", "range_profile", "BLOB NOT NULL DEFAULT x''");
-  db_.Exec("PRAGMA user_version = " + std::to_string(kSchemaVersion));
-  transaction.Commit();
+  db_.exec("PRAGMA user_version = " + std::to_string(kSchemaVersion));
+  transaction.commit();
 }
 
 void JobStore::AddMissingColumn(const std::string& table, const std::string& column,
                                 const std::string& definition) {
-  auto columns = db_.Prepare("SELECT name FROM pragma_table_info(?1)");
-  columns.Bind(1, table);
-  while (columns.Step()) {
-    if (columns.ColumnText(0) == column) return;
+  auto columns = Query(db_, "SELECT name FROM pragma_table_info(?1)", table);
+  while (columns.executeStep()) {
+    if (columns.getColumn(0).getString() == column) return;
   }
-  db_.Exec("ALTER TABLE " + table + " ADD COLUMN " + column + " " + definition);
+  db_.exec("ALTER TABLE " + table + " ADD COLUMN " + column + " " + definition);
 }
 
 int JobStore::BeginRun(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  db_.Prepare("UPDATE jobs SET unended_runs = unended_runs + 1 WHERE job_id = ?1")
-      .Bind(1, job_id)
-      .Run();
-  return ReadUnendedRuns(job_id);
+  return Locked([&] {
+    Run(db_, "UPDATE jobs SET unended_runs = unended_runs + 1 WHERE job_id = ?1", job_id);
+    return ReadUnendedRuns(job_id);
+  });
 }
 
 void JobStore::EndRun(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  db_.Prepare("UPDATE jobs SET unended_runs = 0 WHERE job_id = ?1").Bind(1, job_id).Run();
+  Locked([&] { Run(db_, "UPDATE jobs SET unended_runs = 0 WHERE job_id = ?1", job_id); });
 }
 
 int JobStore::UnendedRuns(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return ReadUnendedRuns(job_id);
+  return Locked([&] { return ReadUnendedRuns(job_id); });
 }
 
 int JobStore::ReadUnendedRuns(const std::string& job_id) {
-  auto stmt = db_.Prepare("SELECT unended_runs FROM jobs WHERE job_id = ?1");
-  stmt.Bind(1, job_id);
-  return stmt.Step() ? static_cast<int>(stmt.ColumnInt(0)) : 0;
+  auto stmt = Query(db_, "SELECT unended_runs FROM jobs WHERE job_id = ?1", job_id);
+  return stmt.executeStep() ? stmt.getColumn(0).getInt() : 0;
 }
 
 StoredScan JobStore::PutScan(const v1::ScanMetadata& metadata, uint64_t num_points,
                              const RangeProfile& ranges) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  // An existing record is kept: of two first uploads racing, the second
-  // finds the first's record and is answered with it.
-  db_.Prepare(
-         "INSERT INTO scans (scan_id, num_points, metadata, range_profile) "
-         "VALUES (?1, ?2, ?3, ?4) "
-         "ON CONFLICT (scan_id) DO UPDATE SET range_profile = ?4 "
-         "WHERE length(scans.range_profile) = 0 AND scans.metadata = ?3")
-      .Bind(1, metadata.sha256())
-      .Bind(2, static_cast<int64_t>(num_points))
-      .BindBlob(3, Serialize(metadata))
-      .BindBlob(4, RangeProfileBytes(ranges))
-      .Run();
-  return *ReadScan(metadata.sha256());
+  return Locked([&] {
+    // An existing record is kept: of two first uploads racing, the second
+    // finds the first's record and is answered with it.
+    Run(db_,
+        "INSERT INTO scans (scan_id, num_points, metadata, range_profile) "
+        "VALUES (?1, ?2, ?3, ?4) "
+        "ON CONFLICT (scan_id) DO UPDATE SET range_profile = ?4 "
+        "WHERE length(scans.range_profile) = 0 AND scans.metadata = ?3",
+        metadata.sha256(), static_cast<int64_t>(num_points), Blob{Serialize(metadata)},
+        Blob{RangeProfileBytes(ranges)});
+    return *ReadScan(metadata.sha256());
+  });
 }
 
 std::optional<StoredScan> JobStore::GetScan(const std::string& scan_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return ReadScan(scan_id);
+  return Locked([&] { return ReadScan(scan_id); });
 }
 
 std::optional<StoredScan> JobStore::ReadScan(const std::string& scan_id) {
-  auto stmt =
-      db_.Prepare("SELECT num_points, metadata, range_profile FROM scans WHERE scan_id = ?1");
-  stmt.Bind(1, scan_id);
-  if (!stmt.Step()) return std::nullopt;
+  auto stmt = Query(db_, "SELECT num_points, metadata, range_profile FROM scans WHERE scan_id = ?1",
+                    scan_id);
+  if (!stmt.executeStep()) return std::nullopt;
   StoredScan scan;
-  scan.num_points = static_cast<uint64_t>(stmt.ColumnInt(0));
-  scan.metadata = Parse<v1::ScanMetadata>(stmt.ColumnBlob(1), "scan");
-  scan.ranges = RangeProfileFromBytes(stmt.ColumnBlob(2));
+  scan.num_points = static_cast<uint64_t>(stmt.getColumn(0).getInt64());
+  scan.metadata = Parse<v1::ScanMetadata>(stmt.getColumn(1).getString(), "scan");
+  scan.ranges = RangeProfileFromBytes(stmt.getColumn(2).getString());
   return scan;
 }
 
 v1::Job JobStore::CreateJob(v1::Job job, const JobInput& input) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  SqliteDatabase::Transaction transaction(db_);
-  auto next = db_.Prepare("SELECT COALESCE(MAX(seq), 0) + 1 FROM jobs");
-  next.Step();
-  const int64_t seq = next.ColumnInt(0);
-  job.set_job_id(JobIdForSeq(seq));
-  db_.Prepare("INSERT INTO jobs (seq, job_id, state, job, request) VALUES (?1, ?2, ?3, ?4, ?5)")
-      .Bind(1, seq)
-      .Bind(2, job.job_id())
-      .Bind(3, static_cast<int64_t>(job.state()))
-      .BindBlob(4, Serialize(job))
-      .BindBlob(5, Serialize(input.request))
-      .Run();
-  auto insert_scan =
-      db_.Prepare("INSERT INTO job_scans (job_id, idx, metadata) VALUES (?1, ?2, ?3)");
-  for (size_t i = 0; i < input.scans.size(); ++i) {
-    insert_scan.Bind(1, job.job_id())
-        .Bind(2, static_cast<int64_t>(i))
-        .BindBlob(3, Serialize(input.scans[i]))
-        .Run();
-    insert_scan.Reset();
-  }
-  transaction.Commit();
-  return job;
+  return Locked([&] {
+    SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const int64_t seq = db_.execAndGet("SELECT COALESCE(MAX(seq), 0) + 1 FROM jobs").getInt64();
+    job.set_job_id(JobIdForSeq(seq));
+    Run(db_, "INSERT INTO jobs (seq, job_id, state, job, request) VALUES (?1, ?2, ?3, ?4, ?5)", seq,
+        job.job_id(), static_cast<int64_t>(job.state()), Blob{Serialize(job)},
+        Blob{Serialize(input.request)});
+    for (size_t i = 0; i < input.scans.size(); ++i) {
+      Run(db_, "INSERT INTO job_scans (job_id, idx, metadata) VALUES (?1, ?2, ?3)", job.job_id(),
+          static_cast<int64_t>(i), Blob{Serialize(input.scans[i])});
+    }
+    transaction.commit();
+    return job;
+  });
 }
 
 std::optional<v1::Job> JobStore::DeleteFinishedJob(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  SqliteDatabase::Transaction transaction(db_);
-  std::optional<v1::Job> job = ReadJob(job_id);
-  if (!job || !rpc::IsTerminal(job->state())) return job;
-  for (const char* table : {"pair_results", "trajectories", "job_scans", "jobs"}) {
-    db_.Prepare(std::string("DELETE FROM ") + table + " WHERE job_id = ?1").Bind(1, job_id).Run();
-  }
-  transaction.Commit();
-  return job;
+  return Locked([&] {
+    SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
+    std::optional<v1::Job> job = ReadJob(job_id);
+    if (!job || !rpc::IsTerminal(job->state())) return job;
+    for (const char* table : {"pair_results", "trajectories", "job_scans", "jobs"}) {
+      Run(db_, std::string("DELETE FROM ") + table + " WHERE job_id = ?1", job_id);
+    }
+    transaction.commit();
+    return job;
+  });
 }
 
 std::set<std::string> JobStore::JobIds() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::set<std::string> ids;
-  auto stmt = db_.Prepare("SELECT job_id FROM jobs");
-  while (stmt.Step()) ids.insert(stmt.ColumnText(0));
-  return ids;
+  return Locked([&] {
+    std::set<std::string> ids;
+    auto stmt = Query(db_, "SELECT job_id FROM jobs");
+    while (stmt.executeStep()) ids.insert(stmt.getColumn(0).getString());
+    return ids;
+  });
 }
 
 std::set<std::string> JobStore::ScansInUse() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::set<std::string> ids;
-  auto stmt = db_.Prepare("SELECT metadata FROM job_scans");
-  while (stmt.Step()) ids.insert(Parse<v1::ScanMetadata>(stmt.ColumnBlob(0), "scan").sha256());
-  return ids;
+  return Locked([&] {
+    std::set<std::string> ids;
+    auto stmt = Query(db_, "SELECT metadata FROM job_scans");
+    while (stmt.executeStep()) {
+      ids.insert(Parse<v1::ScanMetadata>(stmt.getColumn(0).getString(), "scan").sha256());
+    }
+    return ids;
+  });
 }
 
 void JobStore::DeleteScan(const std::string& scan_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  db_.Prepare("DELETE FROM scans WHERE scan_id = ?1").Bind(1, scan_id).Run();
+  Locked([&] { Run(db_, "DELETE FROM scans WHERE scan_id = ?1", scan_id); });
 }
 
 std::vector<std::string> JobStore::JobsFinishedBefore(double cutoff) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<std::string> ids;
-  auto stmt = db_.Prepare("SELECT job FROM jobs");
-  while (stmt.Step()) {
-    const auto job = ParseJob(stmt.ColumnBlob(0));
-    if (rpc::IsTerminal(job.state()) && job.finished_at() < cutoff) ids.push_back(job.job_id());
-  }
-  return ids;
+  return Locked([&] {
+    std::vector<std::string> ids;
+    auto stmt = Query(db_, "SELECT job FROM jobs");
+    while (stmt.executeStep()) {
+      const auto job = ParseJob(stmt.getColumn(0).getString());
+      if (rpc::IsTerminal(job.state()) && job.finished_at() < cutoff) ids.push_back(job.job_id());
+    }
+    return ids;
+  });
 }
 
 bool JobStore::UpdateJob(const v1::Job& job) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  SqliteDatabase::Transaction transaction(db_);
-  const std::optional<v1::Job> stored = ReadJob(job.job_id());
-  if (!stored || rpc::IsTerminal(stored->state())) return false;
-  v1::Job merged = job;
-  if (stored->cancel_requested()) merged.set_cancel_requested(true);
-  WriteJob(merged);
-  transaction.Commit();
-  return true;
+  return Locked([&] {
+    SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
+    const std::optional<v1::Job> stored = ReadJob(job.job_id());
+    if (!stored || rpc::IsTerminal(stored->state())) return false;
+    v1::Job merged = job;
+    if (stored->cancel_requested()) merged.set_cancel_requested(true);
+    WriteJob(merged);
+    transaction.commit();
+    return true;
+  });
 }
 
 std::optional<v1::Job> JobStore::RequestCancel(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  SqliteDatabase::Transaction transaction(db_);
-  std::optional<v1::Job> job = ReadJob(job_id);
-  if (!job || rpc::IsTerminal(job->state()) || job->cancel_requested()) return job;
-  job->set_cancel_requested(true);
-  WriteJob(*job);
-  transaction.Commit();
-  return job;
+  return Locked([&] {
+    SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
+    std::optional<v1::Job> job = ReadJob(job_id);
+    if (!job || rpc::IsTerminal(job->state()) || job->cancel_requested()) return job;
+    job->set_cancel_requested(true);
+    WriteJob(*job);
+    transaction.commit();
+    return job;
+  });
 }
 
 std::optional<v1::Job> JobStore::GetJob(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return ReadJob(job_id);
+  return Locked([&] { return ReadJob(job_id); });
 }
 
 std::optional<v1::Job> JobStore::ReadJob(const std::string& job_id) {
-  auto stmt = db_.Prepare("SELECT job FROM jobs WHERE job_id = ?1");
-  stmt.Bind(1, job_id);
-  if (!stmt.Step()) return std::nullopt;
-  return ParseJob(stmt.ColumnBlob(0));
+  auto stmt = Query(db_, "SELECT job FROM jobs WHERE job_id = ?1", job_id);
+  if (!stmt.executeStep()) return std::nullopt;
+  return ParseJob(stmt.getColumn(0).getString());
 }
 
 void JobStore::WriteJob(const v1::Job& job) {
-  db_.Prepare("UPDATE jobs SET state = ?2, job = ?3 WHERE job_id = ?1")
-      .Bind(1, job.job_id())
-      .Bind(2, static_cast<int64_t>(job.state()))
-      .BindBlob(3, Serialize(job))
-      .Run();
+  Run(db_, "UPDATE jobs SET state = ?2, job = ?3 WHERE job_id = ?1", job.job_id(),
+      static_cast<int64_t>(job.state()), Blob{Serialize(job)});
 }
 
 std::optional<JobInput> JobStore::GetJobInput(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare("SELECT request FROM jobs WHERE job_id = ?1");
-  stmt.Bind(1, job_id);
-  if (!stmt.Step()) return std::nullopt;
-  JobInput input;
-  input.request = Parse<v1::SubmitBatchRequest>(stmt.ColumnBlob(0), "job request");
-  auto scans = db_.Prepare("SELECT metadata FROM job_scans WHERE job_id = ?1 ORDER BY idx");
-  scans.Bind(1, job_id);
-  while (scans.Step()) input.scans.push_back(Parse<v1::ScanMetadata>(scans.ColumnBlob(0), "scan"));
-  return input;
+  return Locked([&]() -> std::optional<JobInput> {
+    auto stmt = Query(db_, "SELECT request FROM jobs WHERE job_id = ?1", job_id);
+    if (!stmt.executeStep()) return std::nullopt;
+    JobInput input;
+    input.request = Parse<v1::SubmitBatchRequest>(stmt.getColumn(0).getString(), "job request");
+    auto scans =
+        Query(db_, "SELECT metadata FROM job_scans WHERE job_id = ?1 ORDER BY idx", job_id);
+    while (scans.executeStep()) {
+      input.scans.push_back(Parse<v1::ScanMetadata>(scans.getColumn(0).getString(), "scan"));
+    }
+    return input;
+  });
 }
 
 JobPage JobStore::ListJobs(int page_size, const std::string& page_token) {
@@ -367,61 +363,62 @@ JobPage JobStore::ListJobs(int page_size, const std::string& page_token) {
       throw InputError("page_token: not a token from a previous ListJobs response");
     }
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare("SELECT seq, job FROM jobs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2");
-  stmt.Bind(1, before).Bind(2, static_cast<int64_t>(page_size) + 1);
-  JobPage page;
-  int64_t last_seq = 0;
-  while (stmt.Step()) {
-    if (static_cast<int>(page.jobs.size()) == page_size) {
-      page.next_page_token = std::to_string(last_seq);
-      break;
+  return Locked([&] {
+    auto stmt = Query(db_, "SELECT seq, job FROM jobs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2",
+                      before, static_cast<int64_t>(page_size) + 1);
+    JobPage page;
+    int64_t last_seq = 0;
+    while (stmt.executeStep()) {
+      if (static_cast<int>(page.jobs.size()) == page_size) {
+        page.next_page_token = std::to_string(last_seq);
+        break;
+      }
+      last_seq = stmt.getColumn(0).getInt64();
+      page.jobs.push_back(ParseJob(stmt.getColumn(1).getString()));
     }
-    last_seq = stmt.ColumnInt(0);
-    page.jobs.push_back(ParseJob(stmt.ColumnBlob(1)));
-  }
-  return page;
+    return page;
+  });
 }
 
 std::vector<v1::Job> JobStore::UnfinishedJobs() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare("SELECT job FROM jobs WHERE state IN (?1, ?2) ORDER BY seq");
-  stmt.Bind(1, static_cast<int64_t>(v1::JOB_STATE_QUEUED))
-      .Bind(2, static_cast<int64_t>(v1::JOB_STATE_RUNNING));
-  std::vector<v1::Job> jobs;
-  while (stmt.Step()) jobs.push_back(ParseJob(stmt.ColumnBlob(0)));
-  return jobs;
+  return Locked([&] {
+    auto stmt = Query(db_, "SELECT job FROM jobs WHERE state IN (?1, ?2) ORDER BY seq",
+                      static_cast<int64_t>(v1::JOB_STATE_QUEUED),
+                      static_cast<int64_t>(v1::JOB_STATE_RUNNING));
+    std::vector<v1::Job> jobs;
+    while (stmt.executeStep()) jobs.push_back(ParseJob(stmt.getColumn(0).getString()));
+    return jobs;
+  });
 }
 
 void JobStore::PutPair(const std::string& job_id, int plan_order, const v1::PairResult& result,
                        const InformationMatrix& information) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  db_.Prepare(
-         "INSERT OR REPLACE INTO pair_results (job_id, source, target, plan_order, result, "
-         "information, answered_by) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)")
-      .Bind(1, job_id)
-      .Bind(2, static_cast<int64_t>(result.source()))
-      .Bind(3, static_cast<int64_t>(result.target()))
-      .Bind(4, static_cast<int64_t>(plan_order))
-      .BindBlob(5, Serialize(result))
-      .BindBlob(6, InformationBytes(information))
-      .Bind(7, rpc::AnsweredBy(result))
-      .Run();
+  Locked([&] {
+    Run(db_,
+        "INSERT OR REPLACE INTO pair_results (job_id, source, target, plan_order, result, "
+        "information, answered_by) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+        job_id, static_cast<int64_t>(result.source()), static_cast<int64_t>(result.target()),
+        static_cast<int64_t>(plan_order), Blob{Serialize(result)},
+        Blob{InformationBytes(information)}, rpc::AnsweredBy(result));
+  });
 }
 
 std::vector<StoredPair> JobStore::GetPairs(const std::string& job_id) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto stmt = db_.Prepare(
-      "SELECT result, information, answered_by FROM pair_results WHERE job_id = ?1 "
-      "ORDER BY plan_order, source, target");
-  stmt.Bind(1, job_id);
+  return Locked([&] { return ReadPairs(job_id); });
+}
+
+std::vector<StoredPair> JobStore::ReadPairs(const std::string& job_id) {
+  auto stmt = Query(db_,
+                    "SELECT result, information, answered_by FROM pair_results WHERE job_id = ?1 "
+                    "ORDER BY plan_order, source, target",
+                    job_id);
   std::vector<StoredPair> pairs;
-  while (stmt.Step()) {
+  while (stmt.executeStep()) {
     StoredPair pair;
-    pair.result = Parse<v1::PairResult>(stmt.ColumnBlob(0), "pair");
-    pair.information = InformationFromBytes(stmt.ColumnBlob(1));
+    pair.result = Parse<v1::PairResult>(stmt.getColumn(0).getString(), "pair");
+    pair.information = InformationFromBytes(stmt.getColumn(1).getString());
     // The column speaks for rows stored before the result carried it.
-    pair.result.set_answered_by(stmt.ColumnText(2));
+    pair.result.set_answered_by(stmt.getColumn(2).getString());
     pairs.push_back(std::move(pair));
   }
   return pairs;
@@ -429,37 +426,32 @@ std::vector<StoredPair> JobStore::GetPairs(const std::string& job_id) {
 
 void JobStore::MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph) {
   const std::set<PairIndex> wanted(in_graph.begin(), in_graph.end());
-  std::vector<StoredPair> pairs = GetPairs(job_id);
-  std::lock_guard<std::mutex> lock(mutex_);
-  SqliteDatabase::Transaction transaction(db_);
-  for (StoredPair& pair : pairs) {
-    const PairIndex index{static_cast<int>(pair.result.source()),
-                          static_cast<int>(pair.result.target())};
-    pair.result.set_in_graph(wanted.count(index) > 0);
-    db_.Prepare(
-           "UPDATE pair_results SET result = ?4 WHERE job_id = ?1 AND source = ?2 AND target = ?3")
-        .Bind(1, job_id)
-        .Bind(2, static_cast<int64_t>(index.source))
-        .Bind(3, static_cast<int64_t>(index.target))
-        .BindBlob(4, Serialize(pair.result))
-        .Run();
-  }
-  transaction.Commit();
+  Locked([&] {
+    SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
+    for (StoredPair& pair : ReadPairs(job_id)) {
+      const PairIndex index{static_cast<int>(pair.result.source()),
+                            static_cast<int>(pair.result.target())};
+      pair.result.set_in_graph(wanted.count(index) > 0);
+      Run(db_,
+          "UPDATE pair_results SET result = ?4 WHERE job_id = ?1 AND source = ?2 AND target = ?3",
+          job_id, static_cast<int64_t>(index.source), static_cast<int64_t>(index.target),
+          Blob{Serialize(pair.result)});
+    }
+    transaction.commit();
+  });
 }
 
 void JobStore::PutTrajectory(const std::string& job_id,
                              const std::vector<v1::TrajectoryPose>& poses) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  SqliteDatabase::Transaction transaction(db_);
-  db_.Prepare("DELETE FROM trajectories WHERE job_id = ?1").Bind(1, job_id).Run();
-  for (const v1::TrajectoryPose& pose : poses) {
-    db_.Prepare("INSERT INTO trajectories (job_id, idx, pose) VALUES (?1, ?2, ?3)")
-        .Bind(1, job_id)
-        .Bind(2, static_cast<int64_t>(pose.index()))
-        .BindBlob(3, Serialize(pose))
-        .Run();
-  }
-  transaction.Commit();
+  Locked([&] {
+    SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
+    Run(db_, "DELETE FROM trajectories WHERE job_id = ?1", job_id);
+    for (const v1::TrajectoryPose& pose : poses) {
+      Run(db_, "INSERT INTO trajectories (job_id, idx, pose) VALUES (?1, ?2, ?3)", job_id,
+          static_cast<int64_t>(pose.index()), Blob{Serialize(pose)});
+    }
+    transaction.commit();
+  });
 }
 
 namespace {
@@ -487,53 +479,52 @@ ResultsCursor ParseResultsToken(const std::string& token) {
 ResultsPage JobStore::GetResultsPage(const std::string& job_id, int page_size,
                                      const std::string& page_token) {
   ResultsCursor cursor = ParseResultsToken(page_token);
-  std::lock_guard<std::mutex> lock(mutex_);
-  ResultsPage page;
-  bool more = false;
-  // One row past the page says whether another page follows.
-  auto pairs = db_.Prepare(
-      "SELECT plan_order, source, target, result, answered_by FROM pair_results "
-      "WHERE job_id = ?1 AND (plan_order, source, target) > (?2, ?3, ?4) "
-      "ORDER BY plan_order, source, target LIMIT ?5");
-  pairs.Bind(1, job_id)
-      .Bind(2, cursor.plan_order)
-      .Bind(3, cursor.source)
-      .Bind(4, cursor.target)
-      .Bind(5, static_cast<int64_t>(page_size) + 1);
-  while (pairs.Step()) {
-    if (static_cast<int>(page.pairs.size()) == page_size) {
-      more = true;
-      break;
+  return Locked([&] {
+    ResultsPage page;
+    bool more = false;
+    // One row past the page says whether another page follows.
+    auto pairs = Query(db_,
+                       "SELECT plan_order, source, target, result, answered_by FROM pair_results "
+                       "WHERE job_id = ?1 AND (plan_order, source, target) > (?2, ?3, ?4) "
+                       "ORDER BY plan_order, source, target LIMIT ?5",
+                       job_id, cursor.plan_order, cursor.source, cursor.target,
+                       static_cast<int64_t>(page_size) + 1);
+    while (pairs.executeStep()) {
+      if (static_cast<int>(page.pairs.size()) == page_size) {
+        more = true;
+        break;
+      }
+      v1::PairResult result = Parse<v1::PairResult>(pairs.getColumn(3).getString(), "pair");
+      result.set_answered_by(pairs.getColumn(4).getString());  // as in GetPairs
+      page.pairs.push_back(std::move(result));
+      cursor.plan_order = pairs.getColumn(0).getInt64();
+      cursor.source = pairs.getColumn(1).getInt64();
+      cursor.target = pairs.getColumn(2).getInt64();
     }
-    v1::PairResult result = Parse<v1::PairResult>(pairs.ColumnBlob(3), "pair");
-    result.set_answered_by(pairs.ColumnText(4));  // as in GetPairs
-    page.pairs.push_back(std::move(result));
-    cursor.plan_order = pairs.ColumnInt(0);
-    cursor.source = pairs.ColumnInt(1);
-    cursor.target = pairs.ColumnInt(2);
-  }
-  auto poses = db_.Prepare(
-      "SELECT idx, pose FROM trajectories WHERE job_id = ?1 AND idx >= ?2 ORDER BY idx LIMIT ?3");
-  poses.Bind(1, job_id).Bind(2, cursor.pose).Bind(3, static_cast<int64_t>(page_size) + 1);
-  int64_t next_pose = cursor.pose;
-  while (poses.Step()) {
-    if (static_cast<int>(page.poses.size()) == page_size) {
-      more = true;
-      break;
+    auto poses = Query(
+        db_,
+        "SELECT idx, pose FROM trajectories WHERE job_id = ?1 AND idx >= ?2 ORDER BY idx LIMIT ?3",
+        job_id, cursor.pose, static_cast<int64_t>(page_size) + 1);
+    int64_t next_pose = cursor.pose;
+    while (poses.executeStep()) {
+      if (static_cast<int>(page.poses.size()) == page_size) {
+        more = true;
+        break;
+      }
+      page.poses.push_back(Parse<v1::TrajectoryPose>(poses.getColumn(1).getString(), "pose"));
+      next_pose = poses.getColumn(0).getInt64() + 1;
     }
-    page.poses.push_back(Parse<v1::TrajectoryPose>(poses.ColumnBlob(1), "pose"));
-    next_pose = poses.ColumnInt(0) + 1;
-  }
-  if (more) {
-    page.next_page_token = std::to_string(cursor.plan_order) + ":" + std::to_string(cursor.source) +
-                           ":" + std::to_string(cursor.target) + ":" + std::to_string(next_pose);
-  }
-  return page;
+    if (more) {
+      page.next_page_token = std::to_string(cursor.plan_order) + ":" +
+                             std::to_string(cursor.source) + ":" + std::to_string(cursor.target) +
+                             ":" + std::to_string(next_pose);
+    }
+    return page;
+  });
 }
 
 void JobStore::Checkpoint() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  db_.Exec("PRAGMA wal_checkpoint(TRUNCATE)");
+  Locked([&] { db_.exec("PRAGMA wal_checkpoint(TRUNCATE)"); });
 }
 
 }  // namespace boicp::server

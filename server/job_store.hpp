@@ -140,9 +140,14 @@ class JobStore {
   std::optional<StoredScan> ReadScan(const std::string& scan_id);
   std::optional<v1::Job> ReadJob(const std::string& job_id);
   void WriteJob(const v1::Job& job);
+  std::vector<StoredPair> ReadPairs(const std::string& job_id);
+  /// Runs `work` holding mutex_, with SQLite's failures as
+  /// RethrowSqliteError throws them.
+  template <typename Work>
+  auto Locked(Work&& work) -> decltype(work());
 
   std::mutex mutex_;
-  SqliteDatabase db_;
+  SQLite::Database db_;
 };
 
 }  // namespace boicp::server

@@ -1,12 +1,14 @@
 #pragma once
 // The boicp.v1.MapBuilder service on gRPC's callback API. Handlers only
 // validate, read the store and queue work; jobs run on the job manager's
-// threads, never inside a handler, so Server::Shutdown is never blocked by one.
+// threads and uploads parse and store their scans on the upload threads,
+// never inside a handler, so Server::Shutdown is never blocked by one.
 
 #include <cstdint>
 
 #include "auth.hpp"
 #include "boicp/io/decode_budget.hpp"
+#include "boicp/util/thread_pool.hpp"
 #include "boicp/v1/map_builder.grpc.pb.h"
 #include "data_dir.hpp"
 #include "job_manager.hpp"
@@ -27,6 +29,9 @@ struct ServiceDeps {
   const BearerAuth& auth;
   UploadBudget& uploads;
   UploadWatchdog& upload_watchdog;
+  // Where uploads check stored copies and parse, store and record their
+  // scans; one thread per upload slot (--max-concurrent-uploads).
+  ThreadPool& upload_threads;
   uint64_t max_scan_bytes = 0;    // larger uploads are RESOURCE_EXHAUSTED
   uint64_t max_scan_points = 0;   // scans decoding to more points are RESOURCE_EXHAUSTED
   uint64_t min_free_bytes = 0;    // below it uploads and batches are FAILED_PRECONDITION

@@ -1,74 +1,54 @@
 #pragma once
-// A thin RAII layer over the SQLite C API: one connection, prepared
-// statements, transactions. Every failure throws std::runtime_error with
-// SQLite's message. Not thread-safe; JobStore serialises access.
+// The job store's SQLite access on SQLiteCpp (libsqlitecpp-dev): opening the
+// connection, binding a statement's parameters in one call, and telling a
+// failing disk from a failing statement.
 
-#include <cstdint>
 #include <string>
 
-struct sqlite3;
-struct sqlite3_stmt;
+#include <SQLiteCpp/Database.h>
+#include <SQLiteCpp/Exception.h>
+#include <SQLiteCpp/Statement.h>
+#include <SQLiteCpp/Transaction.h>
 
 namespace boicp::server {
 
-class SqliteStatement {
- public:
-  SqliteStatement(sqlite3* db, const std::string& sql);
-  ~SqliteStatement();
-  SqliteStatement(const SqliteStatement&) = delete;
-  SqliteStatement& operator=(const SqliteStatement&) = delete;
-
-  // Parameters are 1-based, as in SQLite.
-  SqliteStatement& Bind(int index, int64_t value);
-  SqliteStatement& Bind(int index, double value);
-  SqliteStatement& Bind(int index, const std::string& text);
-  SqliteStatement& BindBlob(int index, const std::string& bytes);
-
-  /// Runs one step; true while a row is available.
-  bool Step();
-  /// Steps to completion, for statements that return no rows.
-  void Run();
-  /// Makes the statement ready to bind and run again.
-  void Reset();
-
-  // Columns are 0-based, as in SQLite.
-  int64_t ColumnInt(int column) const;
-  std::string ColumnText(int column) const;
-  std::string ColumnBlob(int column) const;
-
- private:
-  sqlite3* db_;
-  sqlite3_stmt* stmt_ = nullptr;
+/// Bytes bound as a BLOB (a std::string binds as TEXT, and SQLite never
+/// finds a TEXT value equal to a BLOB one).
+struct Blob {
+  std::string bytes;
 };
 
-class SqliteDatabase {
- public:
-  /// Opens (creating if needed) the database file.
-  explicit SqliteDatabase(const std::string& path);
-  ~SqliteDatabase();
-  SqliteDatabase(const SqliteDatabase&) = delete;
-  SqliteDatabase& operator=(const SqliteDatabase&) = delete;
+/// Opens (creating if needed) the database at `path`, for use from several
+/// threads one at a time, waiting up to 5 s for another connection's lock.
+/// Throws as RethrowSqliteError does.
+SQLite::Database OpenDatabase(const std::string& path);
 
-  /// Runs one or more statements that return nothing.
-  void Exec(const std::string& sql);
-  SqliteStatement Prepare(const std::string& sql) { return SqliteStatement(db_, sql); }
+/// Binds `value` to parameter `index` (1-based): integers, doubles and
+/// strings as SQLiteCpp binds them, a Blob as a BLOB.
+template <typename Value>
+void BindArgument(SQLite::Statement& statement, int index, const Value& value) {
+  statement.bind(index, value);
+}
+void BindArgument(SQLite::Statement& statement, int index, const Blob& blob);
 
-  /// BEGIN IMMEDIATE ... COMMIT; rolls back when destroyed uncommitted.
-  class Transaction {
-   public:
-    explicit Transaction(SqliteDatabase& db);
-    ~Transaction();
-    Transaction(const Transaction&) = delete;
-    Transaction& operator=(const Transaction&) = delete;
-    void Commit();
+/// `sql` prepared with `args` bound to ?1, ?2, ... in order.
+template <typename... Args>
+SQLite::Statement Query(SQLite::Database& db, const std::string& sql, const Args&... args) {
+  SQLite::Statement statement(db, sql);
+  int index = 0;
+  (BindArgument(statement, ++index, args), ...);
+  return statement;
+}
 
-   private:
-    SqliteDatabase& db_;
-    bool done_ = false;
-  };
+/// Runs `sql`, a statement that returns no rows, with `args` bound.
+template <typename... Args>
+void Run(SQLite::Database& db, const std::string& sql, const Args&... args) {
+  Query(db, sql, args...).exec();
+}
 
- private:
-  sqlite3* db_ = nullptr;
-};
+/// Throws `e` again as a StorageError when the disk, not the statement, is
+/// the problem (full, read-only, I/O error, cannot open, no permission),
+/// else as std::runtime_error; both name SQLite's message.
+[[noreturn]] void RethrowSqliteError(const SQLite::Exception& e);
 
 }  // namespace boicp::server

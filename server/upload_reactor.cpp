@@ -37,7 +37,7 @@ void RequirePointLimit(uint64_t points, uint64_t limit) {
 }
 
 // The loaders refuse a scan over the limit from its header, before they
-// allocate its points. With a decode budget the load waits, on this gRPC
+// allocate its points. With a decode budget the load waits, on an upload
 // thread, until the scan's decoding bound fits beside the other decodes (the
 // returned cloud holds its share); a scan that could never fit is refused.
 LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& metadata,
@@ -45,7 +45,14 @@ LoadedCloud LoadUploadedScan(const std::string& path, const v1::ScanMetadata& me
   LoadOptions options = rpc::LoadOptionsFromMetadata(metadata);
   options.max_points = deps.max_scan_points;
   options.decode_budget = deps.decode_budget;
-  options.decode_stop = [context] { return context->IsCancelled(); };
+  // Polled only while the load waits, so its first call marks the wait.
+  options.decode_stop = [context, logged = false]() mutable {
+    if (!logged) {
+      spdlog::info("an upload waits for decoding memory (--max-decode-mb)");
+      logged = true;
+    }
+    return context->IsCancelled();
+  };
   try {
     return LoadPointCloud(path, options);
   } catch (const PointLimitError& e) {
@@ -91,28 +98,40 @@ void UploadReactor::OnReadDone(bool ok) {
     }
     deps_.upload_watchdog.Sent(watch_id_);
   }
-  const grpc::Status status = GuardRpc("UploadScan", [&] {
-    if (ok) {
-      Accept(request_);
-    } else {
-      Complete();
-    }
-    return grpc::Status::OK;
-  });
-  if (!status.ok()) {
-    FinishUpload(status);
-  } else if (ok && !known_) {
-    StartRead(&request_);
-  } else if (ok) {
-    // The daemon holds the bytes the metadata names: answer now rather than
-    // hold a slot while the client sends bytes that would not be read.
-    deps_.upload_watchdog.Sent(watch_id_);
-    FinishUpload(GuardRpc("UploadScan", [&] {
-      Complete();
-      return grpc::Status::OK;
-    }));
+  // A chunk is appended and hashed here. Metadata (which may re-hash a
+  // stored copy) and the end (waiting for decoding memory, parsing, fsync)
+  // go to the upload threads: a gRPC thread they held would be one fewer
+  // for every other call, and enough of them would stall the daemon.
+  if (ok && request_.payload_case() == v1::UploadScanRequest::kChunk) {
+    HandleRead(ok);
   } else {
-    FinishUpload(grpc::Status::OK);
+    deps_.upload_threads.Submit([this, ok] { HandleRead(ok); });
+  }
+}
+
+void UploadReactor::HandleRead(bool ok) {
+  grpc::Status status;
+  {
+    std::lock_guard<std::mutex> lock(steps_);
+    status = GuardRpc("UploadScan", [&] {
+      if (!ok) {
+        Complete();
+      } else {
+        Accept(request_);
+        if (known_) {
+          // The daemon holds the bytes the metadata names: answer now rather
+          // than hold a slot while the client sends bytes that would not be read.
+          deps_.upload_watchdog.Sent(watch_id_);
+          Complete();
+        }
+      }
+      return grpc::Status::OK;
+    });
+  }
+  if (status.ok() && ok && !known_) {
+    StartRead(&request_);
+  } else {
+    FinishUpload(status);
   }
 }
 
@@ -122,11 +141,14 @@ void UploadReactor::FinishUpload(const grpc::Status& status) {
 }
 
 void UploadReactor::OnDone() {
-  if (watch_id_ != 0) deps_.upload_watchdog.Leave(watch_id_);
-  if (temp_.is_open()) temp_.close();
-  if (!temp_path_.empty()) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_path_, ignored);
+  {
+    std::lock_guard<std::mutex> lock(steps_);
+    if (watch_id_ != 0) deps_.upload_watchdog.Leave(watch_id_);
+    if (temp_.is_open()) temp_.close();
+    if (!temp_path_.empty()) {
+      std::error_code ignored;
+      std::filesystem::remove(temp_path_, ignored);
+    }
   }
   delete this;
 }

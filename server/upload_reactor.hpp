@@ -2,9 +2,11 @@
 // UploadScan: metadata first, then the bytes in chunks, written to a temp
 // file and hashed as they arrive. At the end the scan is parsed with the
 // core loaders (so a malformed scan is refused at upload, not mid-batch),
-// then renamed to its hash and recorded. A scan's metadata is written once:
-// stored bytes sent or named again with metadata a batch would read
-// differently are refused (FAILED_PRECONDITION, scan_metadata_once.hpp).
+// then renamed to its hash and recorded, on the daemon's upload threads
+// (ServiceDeps::upload_threads), never on a gRPC thread. A scan's metadata
+// is written once: stored bytes sent or named again with metadata a batch
+// would read differently are refused (FAILED_PRECONDITION,
+// scan_metadata_once.hpp).
 // Refused (FAILED_PRECONDITION) while the data directory cannot take the
 // announced bytes with those of the other uploads in flight, and
 // (RESOURCE_EXHAUSTED) over the upload budget, which an upload reusing
@@ -13,6 +15,7 @@
 // never held for long by a slow client.
 
 #include <fstream>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -39,6 +42,9 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   void OnDone() override;
 
  private:
+  /// Takes in the message just read (or, when !ok, ends the upload), then
+  /// reads the next or finishes.
+  void HandleRead(bool ok);
   void Accept(const ::boicp::v1::UploadScanRequest& request);
   void AcceptMetadata(const ::boicp::v1::ScanMetadata& metadata);
   void AcceptChunk(const std::string& bytes);
@@ -60,6 +66,10 @@ class UploadReactor : public grpc::ServerReadReactor<::boicp::v1::UploadScanRequ
   bool StoredCopyIntact(const std::string& scan_id);
 
   const ServiceDeps& deps_;
+  // The steps run one at a time, on gRPC's threads or the upload threads;
+  // gRPC orders them inside its library, where ThreadSanitizer cannot see,
+  // so the mutex hands each step's state to the next where it can.
+  std::mutex steps_;
   grpc::CallbackServerContext* context_;  // polled for a cancel while decoding waits
   ::boicp::v1::UploadScanResponse* response_;
   ::boicp::v1::UploadScanRequest request_;

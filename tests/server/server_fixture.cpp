@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include "../support/demo_sequence.hpp"
@@ -54,6 +56,24 @@ grpc::Status RawUpload(rpc::MapBuilderClient& client, const v1::ScanMetadata& me
   }
   writer->WritesDone();
   return writer->Finish();
+}
+
+std::string StarScan(int seed) {
+  constexpr int kRays = 100;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  std::string text;
+  char line[96];
+  for (int r = 0; r < kRays; ++r) {
+    const double z = 1.0 - 2.0 * (r + 0.5) / kRays;
+    const double radius = std::sqrt(1.0 - z * z);
+    const double angle = golden * r + 0.01 * seed;
+    for (double d = 1.0; d <= 100.0; d += 0.3) {
+      std::snprintf(line, sizeof line, "%.3f %.3f %.3f\n", d * radius * std::cos(angle),
+                    d * radius * std::sin(angle), d * z);
+      text += line;
+    }
+  }
+  return text;
 }
 
 v1::ScanMetadata Meta(v1::ScanFormat format, size_t size) {
@@ -115,6 +135,23 @@ std::vector<std::string> ServerTest::UploadDrive(rpc::MapBuilderClient& client, 
     if (truth) truth->push_back(scan.T_world_scan);
   }
   return ids;
+}
+
+std::string ServerTest::SubmitLongFusion(rpc::MapBuilderClient& client) {
+  std::vector<std::string> ids;
+  for (int seed = 0; seed < 2; ++seed) {
+    const std::string scan = StarScan(seed);
+    ids.push_back(client.Upload(scan, Meta(v1::SCAN_FORMAT_XYZ, scan.size())).scan_id());
+  }
+  v1::SubmitBatchRequest request = QuickBatch(ids);
+  request.mutable_map()->set_resolution(0.01);
+  request.mutable_map()->set_max_range(150.0);
+  const std::string job_id = client.Submit(request).job_id();
+  const v1::Job fusing = PollJob(
+      client, job_id, [](const v1::Job& j) { return j.stage() == "fusing"; }, 300);
+  EXPECT_EQ(fusing.stage(), "fusing") << fusing.error();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  return job_id;
 }
 
 v1::Job ServerTest::PollJob(rpc::MapBuilderClient& client, const std::string& job_id,

@@ -33,6 +33,12 @@ grpc::Status RawUpload(rpc::MapBuilderClient& client, const v1::ScanMetadata& me
 
 v1::ScanMetadata Meta(v1::ScanFormat format, size_t size);
 
+/// An XYZ scan whose fusion at 1 cm leaves takes seconds yet builds a small
+/// tree: points every 30 cm out to 100 m on 100 rays from the sensor. Each
+/// point casts a ray of up to 10,000 cells, and all of them share the cells
+/// of 100 lines. `seed` turns the star, so that two scans differ.
+std::string StarScan(int seed);
+
 /// The ids among `ids` that FindScans reports missing.
 std::vector<std::string> MissingScans(rpc::MapBuilderClient& client,
                                       const std::vector<std::string>& ids);
@@ -70,6 +76,12 @@ class ServerTest : public ::testing::Test {
   /// `truth`, their poses.
   std::vector<std::string> UploadDrive(rpc::MapBuilderClient& client, int n, uint64_t seed,
                                        std::vector<Transform>* truth = nullptr);
+
+  /// Submits a batch of two star scans at 1 cm leaves and waits until fusion
+  /// has begun its first scan: "fusing" is published just before, and a
+  /// moment later the first between-scans check has passed, seconds before
+  /// the scan ends. Returns the job's id.
+  std::string SubmitLongFusion(rpc::MapBuilderClient& client);
 
   /// Polls GetJob every 50 ms until `done(job)` or `timeout_s`; returns the last job.
   v1::Job PollJob(rpc::MapBuilderClient& client, const std::string& job_id,

@@ -4,7 +4,9 @@
 // could never fit is refused at upload, before it is decoded; jobs decode
 // within the same budget.
 
+#include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <thread>
 #include <vector>
@@ -37,6 +39,14 @@ constexpr int kConcurrentUploads = 8;  // the daemon's default upload concurrenc
 constexpr uint64_t kSlackMb = 150;
 
 class DecodeBudgetUploads : public ServerTest {};
+
+int Occurrences(const std::string& text, const std::string& what) {
+  int count = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) {
+    ++count;
+  }
+  return count;
+}
 
 TEST_F(DecodeBudgetUploads, NearBudgetUploadsAtOnceAllSucceedAndThePeakStaysNearOneDecode) {
   std::vector<std::string> scans;
@@ -121,6 +131,53 @@ TEST_F(DecodeBudgetUploads, JobsDecodeWithinTheBudgetAndFailNamingItWhenAScanCan
   const v1::Job failed = smaller.Watch(smaller.Submit(QuickBatch(ids)).job_id());
   EXPECT_EQ(failed.state(), v1::JOB_STATE_FAILED);
   EXPECT_THAT(failed.error(), HasSubstr("over the decode budget of 1 MiB (--max-decode-mb)"));
+}
+
+// An upload that waits for decoding memory waits on one of the daemon's
+// upload threads, not on a gRPC thread: with more uploads waiting than gRPC
+// has threads for its callbacks, every other call is still answered. The
+// budget is held for seconds by a job fusing a star scan; each upload of
+// another star scan waits, since two never fit at once.
+TEST_F(DecodeBudgetUploads, UploadsWaitingForDecodingMemoryDoNotStallOtherCalls) {
+  const std::filesystem::path star = dir_ / "star.xyz";
+  const std::string star_bytes = StarScan(0);
+  { std::ofstream(star) << star_bytes; }
+  const uint64_t bound = DecodeBoundBytes(star.string());
+  const uint64_t budget_mb = (bound >> 20) + 1;
+  ASSERT_LT(budget_mb << 20, 2 * bound) << "two star scans must not fit at once";
+  constexpr int kWaiting = 24;
+  StartDaemon({"--workers", "2", "--max-decode-mb", std::to_string(budget_mb),
+               "--max-concurrent-uploads", std::to_string(kWaiting)});
+  auto client = Client();
+  const std::string job_id = SubmitLongFusion(client);
+
+  std::vector<grpc::Status> statuses(kWaiting);
+  std::vector<std::thread> uploads;
+  for (int i = 0; i < kWaiting; ++i) {
+    uploads.emplace_back([&, i] {
+      const std::string scan = StarScan(2 + i);
+      auto uploader = Client();
+      statuses[i] = StatusOf([&] { uploader.Upload(scan, Meta(v1::SCAN_FORMAT_XYZ, 0)); });
+    });
+  }
+  // The daemon logs each upload that starts to wait.
+  const auto waiting = [&] { return Occurrences(daemon_->Log(), "waits for decoding memory"); };
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (waiting() < kWaiting && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(waiting(), kWaiting);
+  auto probe = Client();
+  probe.set_unary_timeout(std::chrono::seconds(30));
+  const grpc::Status answered =
+      StatusOf([&] { EXPECT_EQ(probe.GetJob(job_id).stage(), "fusing"); });
+  EXPECT_TRUE(answered.ok()) << answered.error_message();
+
+  client.Cancel(job_id);  // ends the fusion, and frees its share of the budget
+  for (std::thread& upload : uploads) upload.join();
+  for (int i = 0; i < kWaiting; ++i) {
+    EXPECT_TRUE(statuses[i].ok()) << i << ": " << statuses[i].error_message();
+  }
 }
 
 }  // namespace

@@ -51,29 +51,23 @@ v1::PairResult Result(uint32_t source, double fitness) {
 // A first-release database holding one running job and one finished pair,
 // whose result predates answered_by.
 void WriteFirstReleaseDatabase(const std::string& path) {
-  SqliteDatabase db(path);
-  db.Exec(kFirstReleaseTables);
+  SQLite::Database db = OpenDatabase(path);
+  db.exec(kFirstReleaseTables);
   v1::Job job;
   job.set_job_id(kJobId);
   job.set_state(v1::JOB_STATE_RUNNING);
   job.set_stage("fusing");  // the name alone, as before stage_code
-  db.Prepare("INSERT INTO jobs (seq, job_id, state, job, request) VALUES (1, ?1, ?2, ?3, '')")
-      .Bind(1, std::string(kJobId))
-      .Bind(2, static_cast<int64_t>(job.state()))
-      .BindBlob(3, job.SerializeAsString())
-      .Run();
-  db.Prepare(
-        "INSERT INTO pair_results (job_id, source, target, plan_order, result, information) "
-        "VALUES (?1, 0, 1, 0, ?2, '')")
-      .Bind(1, std::string(kJobId))
-      .BindBlob(2, Result(0, 0.75).SerializeAsString())
-      .Run();
+  Run(db, "INSERT INTO jobs (seq, job_id, state, job, request) VALUES (1, ?1, ?2, ?3, '')",
+      std::string(kJobId), static_cast<int64_t>(job.state()), Blob{job.SerializeAsString()});
+  Run(db,
+      "INSERT INTO pair_results (job_id, source, target, plan_order, result, information) "
+      "VALUES (?1, 0, 1, 0, ?2, '')",
+      std::string(kJobId), Blob{Result(0, 0.75).SerializeAsString()});
 }
 
 int64_t UserVersion(const std::string& path) {
-  SqliteDatabase db(path);
-  auto read = db.Prepare("PRAGMA user_version");
-  return read.Step() ? read.ColumnInt(0) : -1;
+  SQLite::Database db = OpenDatabase(path);
+  return db.execAndGet("PRAGMA user_version").getInt64();
 }
 
 class JobStoreMigration : public ::testing::Test {
@@ -142,8 +136,8 @@ TEST_F(JobStoreMigration, AResultWithoutARungIsStoredAsTheFullSearch) {
 TEST_F(JobStoreMigration, ADatabaseOfANewerSchemaIsRefusedAndLeftAsItWas) {
   { JobStore created(path_); }
   {
-    SqliteDatabase db(path_);
-    db.Exec("PRAGMA user_version = " + std::to_string(kSchemaVersion + 1));
+    SQLite::Database db = OpenDatabase(path_);
+    db.exec("PRAGMA user_version = " + std::to_string(kSchemaVersion + 1));
   }
   try {
     JobStore store(path_);
