@@ -2,6 +2,7 @@
 
 #include <lz4frame.h>
 #include <sqlite3.h>
+#include <zlib.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -208,8 +209,8 @@ struct ChunkWriter {
     }
     const std::string compressed = Compress(options.compression, records);
     const uint64_t chunk_at = out->size();
-    const std::string chunk =
-        mcap::Chunk(CompressionName(options.compression), compressed, records.size());
+    const std::string chunk = mcap::Chunk(CompressionName(options.compression), compressed,
+                                          records.size(), mcap::Crc32(records));
     *out += chunk;
     std::string offsets;
     const uint64_t indexes_at = out->size();
@@ -409,9 +410,14 @@ std::string Message(uint16_t channel, int64_t log_time_ns, const std::string& da
 }
 
 std::string Chunk(const std::string& compression, const std::string& records,
-                  uint64_t uncompressed_size) {
-  return Record(0x06, U64(0) + U64(0) + U64(uncompressed_size) + U32(0) + Str(compression) +
-                          U64(records.size()) + records);
+                  uint64_t uncompressed_size, uint32_t uncompressed_crc) {
+  return Record(0x06, U64(0) + U64(0) + U64(uncompressed_size) + U32(uncompressed_crc) +
+                          Str(compression) + U64(records.size()) + records);
+}
+
+uint32_t Crc32(const std::string& bytes) {
+  return static_cast<uint32_t>(
+      crc32_z(0, reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
 }
 
 std::string DataEnd() { return Record(0x0F, U32(0)); }

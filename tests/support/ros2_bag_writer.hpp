@@ -85,9 +85,12 @@ std::string Channel(uint16_t id, uint16_t schema_id, const std::string& topic,
                     const std::string& encoding = "cdr");
 std::string Message(uint16_t channel, int64_t log_time_ns, const std::string& data);
 /// A chunk of `records` as given (already compressed when `compression` is
-/// not empty), declaring `uncompressed_size`.
+/// not empty), declaring `uncompressed_size` and `uncompressed_crc` (the
+/// CRC-32 of the uncompressed records; 0 = none).
 std::string Chunk(const std::string& compression, const std::string& records,
-                  uint64_t uncompressed_size);
+                  uint64_t uncompressed_size, uint32_t uncompressed_crc = 0);
+/// The CRC-32 MCAP stores for `bytes`.
+uint32_t Crc32(const std::string& bytes);
 std::string DataEnd();
 std::string Footer(uint64_t summary_start = 0, uint64_t summary_offset_start = 0);
 std::string Zstd(const std::string& bytes);

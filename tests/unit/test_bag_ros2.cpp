@@ -379,6 +379,36 @@ TEST_F(McapMalformed, ChunkDecompressingToAnotherSize) {
   }
 }
 
+// A chunk whose records do not match its CRC is refused, compressed or not;
+// the round trips above read chunks whose CRCs match, and chunks with none.
+TEST_F(McapMalformed, ChunkFailingItsCrc) {
+  namespace m = test::mcap;
+  const std::string records = m::Message(1, 1, kCdrHeader + std::string(64, '\x2a'));
+  const uint32_t wrong = m::Crc32(records) ^ 0x10u;
+  EXPECT_THAT(
+      Refusal("crc_plain", McapStart() + m::Chunk("", records, records.size(), wrong) + McapEnd()),
+      HasSubstr("fails its CRC check"));
+  EXPECT_THAT(
+      Refusal("crc_zstd",
+              McapStart() + m::Chunk("zstd", m::Zstd(records), records.size(), wrong) + McapEnd()),
+      HasSubstr("the bag is corrupt"));
+  EXPECT_THAT(Refusal("crc_lz4", McapStart() +
+                                     m::Chunk("lz4", m::Lz4Frame(records), records.size(), wrong) +
+                                     McapEnd()),
+              HasSubstr("fails its CRC check"));
+  // A byte of a point changed inside a written bag's uncompressed chunk.
+  McapWriteOptions options;
+  options.compression = McapCompression::kNone;
+  const fs::path whole = dir_.path() / "whole.mcap";
+  test::WriteMcap(whole, DriveContents(), options);
+  std::string bytes = test::ReadBytes(whole);
+  const std::vector<uint8_t> imu = Payload(6, 1000);
+  const size_t payload = bytes.find(std::string(imu.begin(), imu.end()));
+  ASSERT_NE(payload, std::string::npos);
+  bytes[payload + 100] ^= 0x01;
+  EXPECT_THAT(Refusal("flipped", bytes), HasSubstr("fails its CRC check"));
+}
+
 TEST_F(McapMalformed, RecordLengthPastTheEnd) {
   namespace m = test::mcap;
   const std::string message = m::Message(1, 1, kCdrHeader);

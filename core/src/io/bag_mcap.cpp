@@ -6,10 +6,13 @@
 // hold that topic; otherwise (no summary, unchunked, or an index that does not
 // add up) the whole file is read record by record. Every declared length is
 // checked against the bytes present and against BagLimits before anything is
-// allocated from it.
+// allocated from it. A chunk's records are checked against its CRC, where
+// the writer stored one; the data section's and the summary's CRCs are not
+// read (the first would cost a pass over the whole data section).
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include <zlib.h>
+
 #include "bag_readers.hpp"
 #include "boicp/util/types.hpp"
 #include "bounded_file.hpp"
@@ -30,6 +35,16 @@ namespace boicp::io_detail {
 // Named, so that a unity batch holding another bag reader sees no clash.
 namespace mcap_bag {
 namespace {
+
+uint32_t Crc32(const std::vector<uint8_t>& bytes) {
+  return static_cast<uint32_t>(crc32_z(0, bytes.data(), bytes.size()));
+}
+
+std::string Hex(uint32_t value) {
+  char text[16];
+  std::snprintf(text, sizeof text, "0x%08x", value);
+  return text;
+}
 
 constexpr uint8_t kMagic[] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 constexpr uint64_t kMagicSize = sizeof(kMagic);
@@ -408,7 +423,7 @@ class McapBag final : public BagReader {
     head.U64();  // message start time
     head.U64();  // message end time
     const uint64_t uncompressed_size = head.U64();
-    head.U32();  // uncompressed crc
+    const uint32_t uncompressed_crc = head.U32();
     const uint32_t compression_size = head.U32();
     if (compression_size > size - kChunkFixedSize ||
         size - kChunkFixedSize - compression_size < 8) {
@@ -423,18 +438,29 @@ class McapBag final : public BagReader {
     }
     RequireWithinLimit(records_size, where, "compressed records");
     std::vector<uint8_t> records = file_.ReadAt(body_at + records_at, records_size);
-    if (compression.empty()) return records;
-    if (compression != "zstd" && compression != "lz4") {
-      where.Fail("uses compression '" + compression +
-                 "'; boicp reads zstd, lz4 and uncompressed chunks");
+    if (!compression.empty()) {
+      if (compression != "zstd" && compression != "lz4") {
+        where.Fail("uses compression '" + compression +
+                   "'; boicp reads zstd, lz4 and uncompressed chunks");
+      }
+      RequireWithinLimit(uncompressed_size, where, "an uncompressed size");
+      try {
+        records = DecompressChunk(compression == "zstd" ? ChunkCodec::kZstd : ChunkCodec::kLz4Frame,
+                                  records, uncompressed_size);
+      } catch (const InputError& e) {
+        where.Fail(e.what());
+      }
     }
-    RequireWithinLimit(uncompressed_size, where, "an uncompressed size");
-    try {
-      return DecompressChunk(compression == "zstd" ? ChunkCodec::kZstd : ChunkCodec::kLz4Frame,
-                             records, uncompressed_size);
-    } catch (const InputError& e) {
-      where.Fail(e.what());
+    // A flipped bit in a point's bytes would otherwise pass as a point
+    // elsewhere. 0 means the writer computed no CRC.
+    if (uncompressed_crc != 0) {
+      const uint32_t computed = Crc32(records);
+      if (computed != uncompressed_crc) {
+        where.Fail("fails its CRC check (stored " + Hex(uncompressed_crc) + ", computed " +
+                   Hex(computed) + "): the bag is corrupt");
+      }
     }
+    return records;
   }
 
   // --- the linear scan ------------------------------------------------------
