@@ -9,7 +9,8 @@ Every CSV is a boicp-bench results.csv. Rows of the BO methods (those with
 the feature columns) are the samples, `success` the label. The model is a
 logistic regression of success on fitness, the log of the margin and the
 refinement's angular resolution, fitted by Newton's method with a small
-ridge penalty on the --fit rows. It prints the weights as C++ constants,
+ridge penalty on the --fit rows, and capped as the engine caps it (low
+fitness, points the target saw through). It prints the weights as C++ constants,
 then for the --test rows (never used in the fit): the AUROC, the share of
 failures flagged doubtful (confidence < 0.5), the share of successes
 flagged, and a reliability table. --check reports the same for the
@@ -47,8 +48,12 @@ FEATURES = {
 }
 RECORDED = {"confidence": lambda row: float(row["confidence"])}
 # The engine trusts an answer at most in proportion to its fitness below this
-# (kFitnessOfFullTrust in confidence.cpp); predictions apply the same cap.
+# (kFitnessOfFullTrust in confidence.cpp), and from full to no trust as the
+# share of its points the target's sensor saw through goes from the first to
+# the second of SEEN_THROUGH_TRUST (kSeenThroughOfFullTrust, ...NoTrust).
+# Predictions apply the same caps; neither is fitted.
 FITNESS_OF_FULL_TRUST = 0.1
+SEEN_THROUGH_TRUST = (0.15, 0.3)
 RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
 
 
@@ -88,9 +93,16 @@ def fit_logistic(x, y):
     return w
 
 
-def predict(w, x):
+def seen_through(rows):
+    """Each row's seen-through share (0 in files from before it was recorded)."""
+    return np.array([float(row.get("seen_through") or 0.0) for row in rows])
+
+
+def predict(w, x, seen):
     model = 1.0 / (1.0 + np.exp(-(w[0] + x @ w[1:])))
-    return np.minimum(model, np.maximum(x[:, 0], 0.0) / FITNESS_OF_FULL_TRUST)
+    full, none = SEEN_THROUGH_TRUST
+    seen_cap = np.clip((none - seen) / (none - full), 0.0, 1.0)
+    return np.minimum.reduce([model, np.maximum(x[:, 0], 0.0) / FITNESS_OF_FULL_TRUST, seen_cap])
 
 
 def auroc(scores, labels):
@@ -133,7 +145,8 @@ def folds(paths):
         x_fit, y_fit = as_samples(fit_rows)
         x_test, y_test = as_samples(test_rows)
         shipped, _ = as_samples(test_rows, RECORDED)
-        refit = (flagged(predict(fit_logistic(x_fit, y_fit), x_test), y_test)
+        refit = (flagged(predict(fit_logistic(x_fit, y_fit), x_test, seen_through(test_rows)),
+                         y_test)
                  if 0 < y_fit.sum() < len(y_fit) else
                  f"no fit: the other datasets have {int((1 - y_fit).sum())} failures")
         print(f"| {held_out} | {len(test_rows)} | {refit} | {flagged(shipped[:, 0], y_test)} |")
@@ -159,7 +172,8 @@ def main(argv):
     if not args.fit or not args.test:
         sys.exit("fit_confidence.py: give --fit and --test, or --check")
     x_fit, y_fit = read_samples(args.fit)
-    x_test, y_test = read_samples(args.test)
+    test_rows = read_rows(args.test)
+    x_test, y_test = as_samples(test_rows)
     if len(y_fit) == 0 or len(y_test) == 0:
         sys.exit("fit_confidence.py: no BO rows with features in the --fit or --test files")
     w = fit_logistic(x_fit, y_fit)
@@ -169,7 +183,7 @@ def main(argv):
         print(f"constexpr double {name} = {weight:.4g};")
 
     print(f"\ntested on {len(y_test)} other runs ({int((1 - y_test).sum())} failures)")
-    report(predict(w, x_test), y_test)
+    report(predict(w, x_test, seen_through(test_rows)), y_test)
 
 
 if __name__ == "__main__":

@@ -115,6 +115,10 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   EXPECT_THAT(j["sensor"]["why"].get<std::string>(), HasSubstr("ring covering 360 deg"));
   EXPECT_THAT(j["sensor"]["why"].get<std::string>(), HasSubstr("m below the origin"));
   EXPECT_FALSE(j["doubtful"].get<bool>());
+  // A right answer puts next to none of its points where the target's
+  // sensor saw through.
+  EXPECT_GE(j["seen_through"].get<double>(), 0.0);
+  EXPECT_LT(j["seen_through"].get<double>(), 0.05);
   // The answer lies inside its search box.
   EXPECT_GE(j["search_reach"].get<double>(), 0.0);
   EXPECT_LE(j["search_reach"].get<double>(), 1.0);

@@ -11,6 +11,7 @@
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/refinement.hpp"
+#include "boicp/registration/scan_features.hpp"
 #include "evaluation.hpp"
 
 namespace boicp {
@@ -360,6 +361,36 @@ TEST(BoIcpLadder, ADoubtfulPairClimbsEveryRung) {
   ASSERT_EQ(six_dof.attempts.size(), 3u);
   EXPECT_EQ(six_dof.attempts[1].evaluations + six_dof.attempts[2].evaluations, stage_budget);
   EXPECT_EQ(six_dof.attempts.back().kind, AttemptKind::kSearch);
+}
+
+// A scan's features are computed by the first of its pairs that reaches the
+// feature rung, and the next pair gets the same answer from them as from
+// features of its own.
+TEST(BoIcpLadder, PairsSharingAScanComputeItsFeaturesOnce) {
+  const Points world = MakeSyntheticStreet(11, 15.0);
+  const auto scan = [&](double yaw, double x, uint64_t seed) {
+    return SimulateScan(world, PoseFromYawTranslation(yaw, {x, 0.0, 1.8}), 30.0, 0.01, seed);
+  };
+  const Points a = scan(0.0, 0.0, 1), b = scan(2.3, 1.2, 2), c = scan(-1.0, 2.0, 3);
+  const BoIcpConfig config = LadderConfig();
+  const ScanPyramid pa = BuildScanPyramid(a, config), pb = BuildScanPyramid(b, config),
+                    pc = BuildScanPyramid(c, config);
+  ASSERT_EQ(std::max(FeatureStep(pa.levels[0].size()), FeatureStep(pb.levels[0].size())),
+            std::max(FeatureStep(pb.levels[0].size()), FeatureStep(pc.levels[0].size())))
+      << "the test needs both pairs at one feature step";
+
+  const RegistrationResult ab = RegisterPair(pb, pa, config, std::nullopt);
+  const RegistrationResult bc = RegisterPair(pb, pc, config, std::nullopt);
+  EXPECT_EQ(ab.attempts[0].kind, AttemptKind::kFeatures);
+  EXPECT_EQ(bc.attempts[0].kind, AttemptKind::kFeatures);
+  EXPECT_EQ(pa.features->computed(), 1u);
+  EXPECT_EQ(pb.features->computed(), 1u);
+  EXPECT_EQ(pc.features->computed(), 1u);
+
+  const RegistrationResult fresh = RegisterPair(b, c, config);
+  EXPECT_TRUE(bc.transform == fresh.transform);
+  EXPECT_EQ(bc.confidence, fresh.confidence);
+  EXPECT_EQ(bc.answered_by, fresh.answered_by);
 }
 
 TEST(BoIcpLadder, ThreadCountDoesNotChangeTheAnswer) {

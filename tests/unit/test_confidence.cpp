@@ -82,5 +82,40 @@ TEST(Confidence, ANearTieIsDoubtful) {
   EXPECT_GT(Confidence(Features(0.36, 0.6, 0.48)), 0.5);
 }
 
+ConfidenceFeatures SeenThrough(ConfidenceFeatures f, double seen_through) {
+  f.seen_through = seen_through;
+  return f;
+}
+
+// Trust never rises as more of the answer's points land where the target's
+// sensor saw through, and a right answer's few per cent (what moved between
+// the scans) cost nothing.
+TEST(Confidence, FallsWithTheShareSeenThrough) {
+  for (const ConfidenceFeatures& f :
+       {Features(0.7, 0.9, 0.2), Features(0.36, 0.6, 0.48), Features(0.2, 1.0, 0.5)}) {
+    EXPECT_EQ(Confidence(SeenThrough(f, 0.1)), Confidence(f));
+    double previous = Confidence(f);
+    for (double share = 0.0; share <= 1.0; share += 0.02) {
+      const double c = Confidence(SeenThrough(f, share));
+      EXPECT_LE(c, previous) << share;
+      previous = c;
+    }
+    EXPECT_EQ(Confidence(SeenThrough(f, 0.3)), 0.0);
+  }
+}
+
+// Wrong answers the other features trusted: a KITTI street turned 164
+// degrees with a sector cut from the source, and a bunny scan turned 153
+// degrees; each put over a third of its points in front of the target's
+// returns. Their fits and margins alone look right.
+TEST(Confidence, AnAnswerSeenThroughIsDoubtfulWhateverItsFit) {
+  const ConfidenceFeatures street = Features(0.109, 0.43, 0.213);
+  const ConfidenceFeatures bunny = Features(0.184, 0.818, 0.572);
+  EXPECT_GT(Confidence(street), 0.5);
+  EXPECT_GT(Confidence(bunny), 0.5);
+  EXPECT_LT(Confidence(SeenThrough(street, 0.353)), kDoubtfulBelow);
+  EXPECT_LT(Confidence(SeenThrough(bunny, 0.381)), kDoubtfulBelow);
+}
+
 }  // namespace
 }  // namespace boicp

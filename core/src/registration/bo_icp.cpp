@@ -9,13 +9,10 @@
 #include <stdexcept>
 #include <utility>
 
-#include "boicp/icp/nearest_neighbors.hpp"
-#include "boicp/icp/preprocess.hpp"
-#include "boicp/icp/surface_normals.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/feature_hypotheses.hpp"
-#include "boicp/registration/fpfh_features.hpp"
 #include "boicp/registration/refinement.hpp"
+#include "boicp/registration/scan_features.hpp"
 #include "boicp/registration/search_space.hpp"
 #include "staged_search.hpp"
 
@@ -118,35 +115,36 @@ std::vector<Transform> ProbesAround(const Transform& guess, const Point& source_
   return probes;
 }
 
-// Feature hypotheses of the search clouds: FPFH (normals within 3 voxels,
-// features within 5) matched and solved by RANSAC over the correspondences,
-// a few distinct ones, most inliers first. The clouds are first thinned to
-// about kFeaturePoints points (a surface's points fall with the square of
-// the voxel): matching costs the product of the two clouds' sizes, and
-// hypotheses need only land in ICP's basin.
-constexpr size_t kFeaturePoints = 4000;
+// A scan's features at `step` from its search level: the pyramid's own,
+// computed once for every pair, when the pyramid was built at this search
+// voxel.
+std::shared_ptr<const ScanFeatures> FeaturesOf(const ScanPyramid& scan, const Points& search_level,
+                                               int step, const BoIcpConfig& config) {
+  if (!scan.voxels.empty() && scan.voxels[0] == config.voxel) {
+    return scan.features->At(search_level, config.voxel, step, config.threads);
+  }
+  return std::make_shared<const ScanFeatures>(
+      ComputeScanFeatures(search_level, config.voxel, step, config.threads));
+}
 
-std::vector<Transform> FeatureGuesses(const PreparedPair& prepared, const BoIcpConfig& config) {
-  const size_t points = std::max(prepared.search_source.size(), prepared.search_target.size());
-  const double voxel =
-      config.voxel *
-      std::sqrt(std::max(1.0, static_cast<double>(points) / static_cast<double>(kFeaturePoints)));
-  const NearestNeighborIndex source(VoxelDownsample(prepared.search_source, voxel));
-  const NearestNeighborIndex target(VoxelDownsample(prepared.search_target.points(), voxel));
-  const Points source_normals = EstimateSurfaceNormals(source, 3.0 * voxel, config.threads);
-  const Points target_normals = EstimateSurfaceNormals(target, 3.0 * voxel, config.threads);
-  const FpfhFeatures source_features =
-      ComputeFpfhFeatures(source, source_normals, 5.0 * voxel, config.threads);
-  const FpfhFeatures target_features =
-      ComputeFpfhFeatures(target, target_normals, 5.0 * voxel, config.threads);
+// Feature hypotheses of the search clouds: both scans' FPFH at the coarser
+// of their feature steps, matched and solved by RANSAC over the
+// correspondences, a few distinct ones, most inliers first.
+std::vector<Transform> FeatureGuesses(const ScanPyramid& source_scan,
+                                      const ScanPyramid& target_scan, const PreparedPair& prepared,
+                                      const BoIcpConfig& config) {
+  const int step = std::max(FeatureStep(prepared.search_source.size()),
+                            FeatureStep(prepared.search_target.size()));
+  const auto source = FeaturesOf(source_scan, prepared.search_source, step, config);
+  const auto target = FeaturesOf(target_scan, prepared.search_target.points(), step, config);
   FeatureMatchOptions options;
-  options.inlier_distance = 1.5 * voxel;
-  options.distinct_translation = 3.0 * voxel;
+  options.inlier_distance = 1.5 * source->voxel;
+  options.distinct_translation = 3.0 * source->voxel;
   options.seed = config.seed ^ kFeatureSalt;
   options.threads = config.threads;
   std::vector<Transform> guesses;
-  for (const FeatureHypothesis& h : FeatureHypotheses(source.points(), source_features,
-                                                      target.points(), target_features, options)) {
+  for (const FeatureHypothesis& h : FeatureHypotheses(source->points, source->features,
+                                                      target->points, target->features, options)) {
     guesses.push_back(h.transform);
   }
   return guesses;
@@ -202,7 +200,7 @@ class Ladder {
   bool FeatureRung() {
     const auto started = std::chrono::steady_clock::now();
     if (callbacks_.stop_requested && callbacks_.stop_requested()) throw Cancelled();
-    std::vector<Transform> starts = FeatureGuesses(*prepared_, config_);
+    std::vector<Transform> starts = FeatureGuesses(source_, target_, *prepared_, config_);
     const size_t hypotheses = starts.size();
     starts.insert(starts.end(), learned_.begin(), learned_.end());
     if (starts.empty()) return false;

@@ -25,6 +25,13 @@ constexpr double kMarginFloor = 0.01;
 // answer. Under half this fitness an answer is always doubtful. Right
 // answers match far more (bench/README.md).
 constexpr double kFitnessOfFullTrust = 0.1;
+// An answer that moves its points into space the target's sensor saw
+// through is wrong unless the scene moved: trust falls from full at 15 % of
+// the points to none at 30 %. A right answer's share is what moved between
+// the scans plus sampling at depth edges, a few per cent; a street turned
+// half round puts a third of its points there (bench/README.md).
+constexpr double kSeenThroughOfFullTrust = 0.15;
+constexpr double kSeenThroughOfNoTrust = 0.3;
 
 }  // namespace
 
@@ -33,7 +40,10 @@ double Confidence(const ConfidenceFeatures& f) {
                    kLogMargin * std::log(f.margin + kMarginFloor) +
                    kResolutionDeg * f.resolution_deg;
   const double model = 1.0 / (1.0 + std::exp(-z));
-  return std::min(model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust);
+  const double seen_through_cap = std::clamp(
+      (kSeenThroughOfNoTrust - f.seen_through) / (kSeenThroughOfNoTrust - kSeenThroughOfFullTrust),
+      0.0, 1.0);
+  return std::min({model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, seen_through_cap});
 }
 
 }  // namespace boicp

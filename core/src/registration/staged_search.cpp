@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "boicp/icp/alignment_score.hpp"
+#include "boicp/icp/free_space.hpp"
 #include "boicp/icp/icp.hpp"
 #include "boicp/icp/preprocess.hpp"
 
@@ -62,6 +63,23 @@ double BasinSupport(const std::vector<Evaluation>& history, const Transform& ans
   return first_stage > 0 ? static_cast<double>(in_basin) / first_stage : 0.0;
 }
 
+// SeenThroughShare of the finest source points, from the target sensor at
+// its frame's origin (-target_centre among the centred points), beyond 3
+// finest voxels. A view of fewer than kViewCells cells (about 13 by 13
+// degrees) is not a sensor's: the scan's origin is elsewhere.
+constexpr size_t kViewCells = 200;
+
+double SeenThrough(const PreparedPair& pair, const Transform& centred, const BoIcpConfig& config) {
+  const bool pyramid = !pair.pyramid.empty();
+  const Points& source = pyramid ? pair.pyramid.back().source : pair.search_source;
+  const NearestNeighborIndex& target = pyramid ? pair.pyramid.back().target : pair.search_target;
+  const double voxel = pyramid ? pair.pyramid.back().voxel : config.voxel;
+  const RangeImage view(target.points(), -pair.target_centre);
+  if (view.covered_cells() < kViewCells) return 0.0;
+  return SeenThroughShare(source, target, view, centred, 3.0 * voxel,
+                          config.EffectiveInlierDistance());
+}
+
 // The confidence features of the outcome's refined answer, and its overlap.
 void Assess(SearchOutcome& out, const BoIcpConfig& config) {
   out.features.fitness = out.refined.score.fitness;
@@ -70,6 +88,7 @@ void Assess(SearchOutcome& out, const BoIcpConfig& config) {
   out.features.resolution_deg = out.refined.resolution_deg;
   out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
   out.features.probability_better = out.probability_better;
+  out.features.seen_through = SeenThrough(*out.prepared, out.refined.transform, config);
   out.confidence = Confidence(out.features);
   out.overlap = ScoreAlignment(out.prepared->search_source, out.prepared->search_target,
                                out.refined.transform, 1.5 * config.voxel, config.threads)

@@ -7,8 +7,8 @@
 namespace boicp {
 
 /// What the engine knows about its own answer when it finishes. The model
-/// weighs fitness, log(margin) and resolution; the rest is reported for fitting
-/// and diagnosis.
+/// weighs fitness, log(margin) and resolution, and fitness and seen_through
+/// cap it; the rest is reported for fitting and diagnosis.
 struct ConfidenceFeatures {
   double fitness = 0.0;     // inlier fraction at the finest level, in [0, 1]
   double rmse_ratio = 0.0;  // inlier RMSE / inlier distance, in [0, 1]
@@ -16,11 +16,16 @@ struct ConfidenceFeatures {
   double support = 0.0;     // share of the first stage's runs that ended in the answer's basin
   double probability_better = 0.0;  // the surrogate's P(an unexplored start does better)
   double resolution_deg = 0.0;      // RefinedAlignment::resolution_deg
+  /// SeenThroughShare of the finest source points in the target's view from
+  /// its frame's origin, in [0, 1]; 0 when that view covers too few
+  /// directions to say (the origin is not where a sensor stood).
+  double seen_through = 0.0;
 };
 
 /// Estimated probability, in [0, 1), that the answer is within the success
 /// thresholds (2 degrees, and a few refinement voxels of translation); 0
-/// with no inliers.
+/// with no inliers, under 0.5 with fitness under 0.05 or seen_through over
+/// 0.225, and 0 with seen_through of 0.3 or more.
 double Confidence(const ConfidenceFeatures& features);
 
 }  // namespace boicp

@@ -13,6 +13,7 @@
 #include "boicp/icp/nearest_neighbors.hpp"
 #include "boicp/icp/preprocess.hpp"
 #include "boicp/registration/config.hpp"
+#include "boicp/registration/scan_features.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -43,6 +44,9 @@ struct ScanPyramid {
   Points cropped;                // the raw scan within the range limits, minus `centre`
   std::vector<double> voxels;    // metres: the search voxel, then the refinement levels
   std::vector<Points> levels;    // `cropped` downsampled at each of `voxels`
+  /// levels[0]'s FPFH features, computed by the first pair that needs them;
+  /// copies of the pyramid, which hold the same levels, share them.
+  std::shared_ptr<ScanFeatureMemo> features = std::make_shared<ScanFeatureMemo>();
 };
 
 /// The voxels of config's pyramid: config.voxel, then halving from
