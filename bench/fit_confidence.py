@@ -10,7 +10,8 @@ the feature columns) are the samples, `success` the label. The model is a
 logistic regression of success on fitness, the log of the margin and the
 refinement's angular resolution, fitted by Newton's method with a small
 ridge penalty on the --fit rows, and capped as the engine caps it (low
-fitness, points the target saw through). It prints the weights as C++ constants,
+fitness, a near tie with a measured runner-up, points the target saw
+through). It prints the weights as C++ constants,
 then for the --test rows (never used in the fit): the AUROC, the share of
 failures flagged doubtful (confidence < 0.5), the share of successes
 flagged, and a reliability table. --check reports the same for the
@@ -48,11 +49,14 @@ FEATURES = {
 }
 RECORDED = {"confidence": lambda row: float(row["confidence"])}
 # The engine trusts an answer at most in proportion to its fitness below this
-# (kFitnessOfFullTrust in confidence.cpp), and from full to no trust as the
-# share of its points the target's sensor saw through goes from the first to
-# the second of SEEN_THROUGH_TRUST (kSeenThroughOfFullTrust, ...NoTrust).
-# Predictions apply the same caps; neither is fitted.
+# (kFitnessOfFullTrust in confidence.cpp); from no to full trust as a measured
+# margin goes from the first to the second of MARGIN_TRUST (kMarginFloor,
+# kMarginOfFullTrust); and from full to no trust as the share of its points
+# the target's sensor saw through goes from the first to the second of
+# SEEN_THROUGH_TRUST (kSeenThroughOfFullTrust, ...NoTrust). Predictions apply
+# the same caps; none is fitted.
 FITNESS_OF_FULL_TRUST = 0.1
+MARGIN_TRUST = (MARGIN_FLOOR, 0.03)
 SEEN_THROUGH_TRUST = (0.15, 0.3)
 RIDGE = 1e-2  # keeps the weights finite when the fit rows are separable
 
@@ -93,16 +97,23 @@ def fit_logistic(x, y):
     return w
 
 
-def seen_through(rows):
-    """Each row's seen-through share (0 in files from before it was recorded)."""
-    return np.array([float(row.get("seen_through") or 0.0) for row in rows])
-
-
-def predict(w, x, seen):
-    model = 1.0 / (1.0 + np.exp(-(w[0] + x @ w[1:])))
+def caps(rows):
+    """Each row's cap from a near tie and from the share seen through. Files
+    from before margin_measured was recorded take a margin above 0 as
+    measured; from before seen_through, a share of 0."""
+    margin = np.array([float(row["margin"]) for row in rows])
+    measured = np.array([row["margin_measured"] == "1" if row.get("margin_measured")
+                         else float(row["margin"]) > 0 for row in rows])
+    none, full = MARGIN_TRUST
+    tie_cap = np.where(measured, np.clip((margin - none) / (full - none), 0.0, 1.0), 1.0)
+    seen = np.array([float(row.get("seen_through") or 0.0) for row in rows])
     full, none = SEEN_THROUGH_TRUST
-    seen_cap = np.clip((none - seen) / (none - full), 0.0, 1.0)
-    return np.minimum.reduce([model, np.maximum(x[:, 0], 0.0) / FITNESS_OF_FULL_TRUST, seen_cap])
+    return np.minimum(tie_cap, np.clip((none - seen) / (none - full), 0.0, 1.0))
+
+
+def predict(w, x, cap):
+    model = 1.0 / (1.0 + np.exp(-(w[0] + x @ w[1:])))
+    return np.minimum.reduce([model, np.maximum(x[:, 0], 0.0) / FITNESS_OF_FULL_TRUST, cap])
 
 
 def auroc(scores, labels):
@@ -145,7 +156,7 @@ def folds(paths):
         x_fit, y_fit = as_samples(fit_rows)
         x_test, y_test = as_samples(test_rows)
         shipped, _ = as_samples(test_rows, RECORDED)
-        refit = (flagged(predict(fit_logistic(x_fit, y_fit), x_test, seen_through(test_rows)),
+        refit = (flagged(predict(fit_logistic(x_fit, y_fit), x_test, caps(test_rows)),
                          y_test)
                  if 0 < y_fit.sum() < len(y_fit) else
                  f"no fit: the other datasets have {int((1 - y_fit).sum())} failures")
@@ -183,7 +194,7 @@ def main(argv):
         print(f"constexpr double {name} = {weight:.4g};")
 
     print(f"\ntested on {len(y_test)} other runs ({int((1 - y_test).sum())} failures)")
-    report(predict(w, x_test, seen_through(test_rows)), y_test)
+    report(predict(w, x_test, caps(test_rows)), y_test)
 
 
 if __name__ == "__main__":

@@ -164,12 +164,14 @@ TEST(Refinement, MarginNeedsARunnerUpAndInliers) {
   const RefinedAlignment alone = RefineCoarseToFine({Transform::Identity()}, pair, config);
   EXPECT_GT(alone.score.fitness, 0.99);
   EXPECT_EQ(alone.margin, 0.0);
+  EXPECT_FALSE(alone.margin_measured);
 
   // A clearly worse basin beside it: the margin is large but measured.
   const RefinedAlignment compared =
       RefineCoarseToFine({Transform::Identity(), wrong}, pair, config);
   EXPECT_GT(compared.margin, 0.5);
   EXPECT_LT(compared.margin, 1.0);
+  EXPECT_TRUE(compared.margin_measured);
 
   // Starts 100 m away from every point: no inliers, no margin.
   Transform far = Transform::Identity();
@@ -179,6 +181,7 @@ TEST(Refinement, MarginNeedsARunnerUpAndInliers) {
   const RefinedAlignment nothing = RefineCoarseToFine({far, farther}, pair, config);
   EXPECT_EQ(nothing.score.fitness, 0.0);
   EXPECT_EQ(nothing.margin, 0.0);
+  EXPECT_FALSE(nothing.margin_measured);
 }
 
 TEST(Refinement, RmsRadiusOfACubesCornersIsItsHalfDiagonal) {

@@ -19,6 +19,12 @@ constexpr double kResolutionDeg = -6.037;
 // wrong basin, and the log tells a 2 % margin from a 15 % one where a linear
 // term barely does. The floor is about the precision of a fitness.
 constexpr double kMarginFloor = 0.01;
+// Two basins whose fitnesses differ by no more than that precision are a
+// tie, and the data cannot say which is right: a measured margin is trusted
+// from none at kMarginFloor to full at kMarginOfFullTrust, whatever the fit.
+// The log term alone lets a high fitness outweigh a tie (bench/README.md
+// has the margins of right and wrong answers).
+constexpr double kMarginOfFullTrust = 0.03;
 // An answer that matches few of the source's points is trusted at most in
 // proportion to them, whatever the model says: between two near-empty fits
 // the margin is a ratio of noise, and with no inliers nothing supports the
@@ -40,10 +46,15 @@ double Confidence(const ConfidenceFeatures& f) {
                    kLogMargin * std::log(f.margin + kMarginFloor) +
                    kResolutionDeg * f.resolution_deg;
   const double model = 1.0 / (1.0 + std::exp(-z));
+  const double tie_cap =
+      f.margin_measured
+          ? std::clamp((f.margin - kMarginFloor) / (kMarginOfFullTrust - kMarginFloor), 0.0, 1.0)
+          : 1.0;
   const double seen_through_cap = std::clamp(
       (kSeenThroughOfNoTrust - f.seen_through) / (kSeenThroughOfNoTrust - kSeenThroughOfFullTrust),
       0.0, 1.0);
-  return std::min({model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, seen_through_cap});
+  return std::min(
+      {model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, tie_cap, seen_through_cap});
 }
 
 }  // namespace boicp

@@ -252,9 +252,10 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   }
   if (refined.score.fitness <= 0.0 || starts.size() == 1) {
     refined.margin = 0.0;  // nothing fits, or nothing was compared
-  } else if (runner_up) {
-    refined.margin = std::max(0.0, 1.0 - *runner_up / refined.score.fitness);
+    return refined;
   }
+  refined.margin_measured = true;
+  if (runner_up) refined.margin = std::max(0.0, 1.0 - *runner_up / refined.score.fitness);
   return refined;
 }
 

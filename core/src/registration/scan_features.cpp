@@ -13,8 +13,8 @@ constexpr double kFeaturePoints = 4000.0;
 
 int FeatureStep(size_t search_points) {
   if (static_cast<double>(search_points) <= kFeaturePoints) return 0;
-  return std::max(0, static_cast<int>(std::lround(
-                         std::log2(static_cast<double>(search_points) / kFeaturePoints))));
+  return static_cast<int>(
+      std::lround(std::log2(static_cast<double>(search_points) / kFeaturePoints)));
 }
 
 double FeatureVoxel(double search_voxel, int step) {

@@ -85,6 +85,7 @@ void Assess(SearchOutcome& out, const BoIcpConfig& config) {
   out.features.fitness = out.refined.score.fitness;
   out.features.rmse_ratio = out.refined.score.inlier_rmse / config.EffectiveInlierDistance();
   out.features.margin = out.refined.margin;
+  out.features.margin_measured = out.refined.margin_measured;
   out.features.resolution_deg = out.refined.resolution_deg;
   out.features.support = BasinSupport(out.history, out.refined.transform, config.voxel);
   out.features.probability_better = out.probability_better;

@@ -7,13 +7,14 @@
 namespace boicp {
 
 /// What the engine knows about its own answer when it finishes. The model
-/// weighs fitness, log(margin) and resolution, and fitness and seen_through
-/// cap it; the rest is reported for fitting and diagnosis.
+/// weighs fitness, log(margin) and resolution; fitness, a measured margin and
+/// seen_through cap it; the rest is reported for fitting and diagnosis.
 struct ConfidenceFeatures {
-  double fitness = 0.0;     // inlier fraction at the finest level, in [0, 1]
-  double rmse_ratio = 0.0;  // inlier RMSE / inlier distance, in [0, 1]
-  double margin = 0.0;      // RefinedAlignment::margin, in [0, 1]
-  double support = 0.0;     // share of the first stage's runs that ended in the answer's basin
+  double fitness = 0.0;          // inlier fraction at the finest level, in [0, 1]
+  double rmse_ratio = 0.0;       // inlier RMSE / inlier distance, in [0, 1]
+  double margin = 0.0;           // RefinedAlignment::margin, in [0, 1]
+  bool margin_measured = false;  // RefinedAlignment::margin_measured
+  double support = 0.0;          // share of the first stage's runs that ended in the answer's basin
   double probability_better = 0.0;  // the surrogate's P(an unexplored start does better)
   double resolution_deg = 0.0;      // RefinedAlignment::resolution_deg
   /// SeenThroughShare of the finest source points in the target's view from
@@ -24,8 +25,9 @@ struct ConfidenceFeatures {
 
 /// Estimated probability, in [0, 1), that the answer is within the success
 /// thresholds (2 degrees, and a few refinement voxels of translation); 0
-/// with no inliers, under 0.5 with fitness under 0.05 or seen_through over
-/// 0.225, and 0 with seen_through of 0.3 or more.
+/// with no inliers, under 0.5 with fitness under 0.05, a measured margin
+/// under 0.02 or seen_through over 0.225, and 0 with a measured margin of
+/// 0.01 or less or seen_through of 0.3 or more.
 double Confidence(const ConfidenceFeatures& features);
 
 }  // namespace boicp

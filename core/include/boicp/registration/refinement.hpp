@@ -118,6 +118,9 @@ struct RefinedAlignment {
   /// radius by one refinement voxel, degrees: how finely that level can
   /// resolve the rotation.
   double resolution_deg = 0.0;
+  /// True when the margin compared the answer with other starts (two or
+  /// more, and the answer has inliers): a margin of 0 is then a tie.
+  bool margin_measured = false;
 };
 
 /// Coarse-to-fine point-to-point ICP from each of `starts` (T_target_source,
