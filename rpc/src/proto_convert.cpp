@@ -27,7 +27,7 @@ constexpr std::pair<CloudFormat, v1::ScanFormat> kScanFormats[] = {
 // Every pairing mode with its API value (MODE_UNSPECIFIED reads as consecutive).
 constexpr std::pair<PairingMode, v1::PairingPolicy::Mode> kPairingModes[] = {
     {PairingMode::kConsecutive, v1::PairingPolicy::MODE_CONSECUTIVE},
-    {PairingMode::kOverlap, v1::PairingPolicy::MODE_KEYFRAMES},
+    {PairingMode::kOverlap, v1::PairingPolicy::MODE_OVERLAP},
     {PairingMode::kExplicit, v1::PairingPolicy::MODE_EXPLICIT},
 };
 

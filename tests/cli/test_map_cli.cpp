@@ -539,7 +539,7 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
   cases[0].pairing.set_mode(v1::PairingPolicy::MODE_CONSECUTIVE);
   cases[1].name = "overlap";
   cases[1].cli_flags = "overlap";
-  cases[1].pairing.set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  cases[1].pairing.set_mode(v1::PairingPolicy::MODE_OVERLAP);
   cases[2].name = "explicit";
   cases[2].cli_flags = "explicit " + pairs_file.string();
   cases[2].pairing.set_mode(v1::PairingPolicy::MODE_EXPLICIT);
@@ -553,7 +553,7 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
   add_pair(cases[3].pairing, 5, 1);
   cases[4].name = "overlap-at-0.8-with-a-closure";
   cases[4].cli_flags = "overlap --overlap-threshold 0.8 --extra-pairs " + closure_file.string();
-  cases[4].pairing.set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  cases[4].pairing.set_mode(v1::PairingPolicy::MODE_OVERLAP);
   cases[4].pairing.set_overlap_threshold(0.8);
   add_pair(cases[4].pairing, 5, 1);
 

@@ -87,7 +87,7 @@ TEST_F(BadInput, EachCaseGetsItsStatusAndTheDaemonStaysUp) {
   bad_map.mutable_map()->set_resolution(-0.1);
   EXPECT_EQ(submit_code(bad_map), Code::INVALID_ARGUMENT) << "negative resolution";
   v1::SubmitBatchRequest bad_threshold = QuickBatch(ids);
-  bad_threshold.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  bad_threshold.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_OVERLAP);
   bad_threshold.mutable_pairing()->set_overlap_threshold(1.5);
   EXPECT_EQ(submit_code(bad_threshold), Code::INVALID_ARGUMENT) << "overlap threshold";
 

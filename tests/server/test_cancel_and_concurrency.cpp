@@ -86,7 +86,7 @@ TEST_F(CancelAndConcurrency, LoopClosuresOptimiseThePoseGraphAndWrongOnesArePrun
     loop->set_target(0);
   }
   v1::SubmitBatchRequest keyframes = consecutive;
-  keyframes.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_KEYFRAMES);
+  keyframes.mutable_pairing()->set_mode(v1::PairingPolicy::MODE_OVERLAP);
   // No two scans 4 m apart overlap this much, so every scan becomes a
   // keyframe after one wasted probe: chain (1,0) (2,1) (3,2) (4,3).
   keyframes.mutable_pairing()->set_overlap_threshold(0.999);

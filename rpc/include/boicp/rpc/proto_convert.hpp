@@ -48,7 +48,7 @@ v1::ScanContext ScanContextOf(const ScanSource& scan);
 /// optional sha256 (64 lowercase hex digits). Throws InputError naming the field.
 void ValidateScanMetadata(const v1::ScanMetadata& metadata);
 
-/// A batch's pairing as asked (MODE_UNSPECIFIED is consecutive, MODE_KEYFRAMES
+/// A batch's pairing as asked (MODE_UNSPECIFIED is consecutive, MODE_OVERLAP
 /// overlap). Throws InputError for a mode this daemon does not know.
 PairingRequest PairingFromProto(const v1::PairingPolicy& proto);
 v1::PairingPolicy PairingToProto(const PairingRequest& pairing);
