@@ -26,6 +26,7 @@ json ScanSettings(const ScanSource& scan) {
   }
   if (const std::optional<BagMessageRef>& m = scan.load.bag_message) {
     out["bag_message"] = {m->log_time_ns, m->position, m->offset, m->size};
+    if (m->file > 0) out["bag_message"].push_back(m->file);  // a split bag's later files
   }
   out["prior_pose"] = scan.prior_pose ? TransformToJson(*scan.prior_pose) : json(nullptr);
   return out;

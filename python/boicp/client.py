@@ -32,6 +32,7 @@ import enum
 import hashlib
 import importlib
 import os
+import pathlib
 from typing import Callable, Iterator, Optional, Sequence, Union
 
 import grpc
@@ -333,7 +334,9 @@ class Client:
         after all. As rpc's ``MapBuilderClient::Upload``.
         """
         with open(path, "rb") as f:
-            data = f.read()
+            return self._upload_bytes(f.read(), metadata)
+
+    def _upload_bytes(self, data: bytes, metadata: MetadataLike) -> pb.UploadScanResponse:
         message = _as_metadata(metadata)
         message.sha256 = hashlib.sha256(data).hexdigest()
         message.size_bytes = len(data)
@@ -361,15 +364,21 @@ class Client:
         if len(paths) != len(metadata_list):
             raise ValueError(f"upload_scans: {len(paths)} paths but "
                              f"{len(metadata_list)} metadata entries")
+        return self._upload_all(lambda i: pathlib.Path(paths[i]).read_bytes(), metadata_list,
+                                progress)
+
+    def _upload_all(self, read: Callable[[int], bytes], metadata_list: Sequence[MetadataLike],
+                    progress: Optional[ProgressCallback]) -> list:
+        """Uploads scan i's bytes, ``read(i)``, with ``metadata_list[i]``, in order."""
         ids = []
         sent_bytes = 0
-        for done, (path, metadata) in enumerate(zip(paths, metadata_list), start=1):
-            response = self.upload_scan(path, metadata)
+        for done, metadata in enumerate(metadata_list, start=1):
+            response = self._upload_bytes(read(done - 1), metadata)
             ids.append(response.scan_id)
             if not response.already_present:
                 sent_bytes += response.size_bytes
             if progress is not None:
-                progress(done, len(paths), sent_bytes)
+                progress(done, len(metadata_list), sent_bytes)
         return ids
 
     # -- jobs -----------------------------------------------------------------
@@ -377,10 +386,15 @@ class Client:
     def submit(self, scans: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]], *,
                label: Optional[str] = None, progress: Optional[ProgressCallback] = None,
                **settings) -> str:
-        """Submits a folder of scans as ``boicp submit FOLDER`` does; returns the job id.
+        """Submits a folder of scans or a bag as ``boicp submit PATH`` does; returns the job id.
 
-        ``scans`` is the folder, or a list of scan files (their formats from
-        their extensions; depth images need ``intrinsics`` and ``depth_scale``).
+        ``scans`` is the folder or the bag (``.bag``, ``.db3``, ``.mcap`` or a
+        ROS 2 bag folder; ``topic``, ``odometry_topic``, ``start`` and
+        ``duration`` as ``boicp.build_map`` takes them), or a list of scan
+        files (their formats from their extensions; depth images need
+        ``intrinsics`` and ``depth_scale``). A bag's scans are uploaded as
+        ``boicp submit`` uploads them, one at a time, each as the binary PCD
+        of its points.
 
         ``settings`` are named as ``boicp.build_map`` takes them (``config``, ``voxel``,
         ``seed``, ``resolution``, ``pairing``, ``first``, ``stride``,
@@ -401,9 +415,8 @@ class Client:
         plan = planner.plan_submission([os.fspath(s) for s in scans] if listed else os.fspath(scans),
                                        settings)
         request = pb.SubmitBatchRequest.FromString(plan["request"])
-        scans = plan["scans"]
-        request.scan_ids[:] = self.upload_scans(
-            [scan["path"] for scan in scans], [scan["metadata"] for scan in scans], progress)
+        request.scan_ids[:] = self._upload_all(
+            plan["read"], [scan["metadata"] for scan in plan["scans"]], progress)
         if label is not None:
             request.label = label
         return self._unary("SubmitBatch", request).job_id

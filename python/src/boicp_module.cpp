@@ -23,6 +23,7 @@
 #include "python_interrupt.hpp"
 #include "python_progress.hpp"
 #ifdef BOICP_WITH_REMOTE_COMMANDS
+#include "boicp/rpc/map_builder_client.hpp"
 #include "boicp/rpc/proto_convert.hpp"
 #include "submit_request.hpp"
 #endif
@@ -142,7 +143,31 @@ py::object BuildMap(const std::string& folder, const std::string& out_dir, const
 }
 
 #ifdef BOICP_WITH_REMOTE_COMMANDS
-// `scans`: a folder (str), or a sequence of scan files.
+// The bytes each planned scan is uploaded as (rpc::ScanUploadBytes), read
+// one at a time when asked, so that a bag's scans are never all in memory.
+class PlannedScanBytes {
+ public:
+  explicit PlannedScanBytes(std::vector<ScanSource> scans) : scans_(std::move(scans)) {}
+
+  py::bytes Read(size_t index) const {
+    if (index >= scans_.size()) {
+      throw py::index_error("scan " + std::to_string(index) + " of " +
+                            std::to_string(scans_.size()));
+    }
+    std::string bytes;
+    {
+      py::gil_scoped_release release;
+      bytes = rpc::ScanUploadBytes(scans_[index]);
+    }
+    return py::bytes(bytes);
+  }
+  size_t size() const { return scans_.size(); }
+
+ private:
+  std::vector<ScanSource> scans_;
+};
+
+// `scans`: a folder or a bag (str), or a sequence of scan files.
 py::dict PlanSubmission(const py::object& scans, const py::dict& settings) {
   json by_name = JsonOf(settings);
   const std::string label = by_name.value("label", std::string());
@@ -157,11 +182,6 @@ py::dict PlanSubmission(const py::object& scans, const py::dict& settings) {
                         settings::kSubmit, "boicp.client.submit");
   const cli::LocalRun run =
       folder ? cli::PrepareRun(map_settings) : cli::PrepareRun(map_settings, files);
-  if (run.layout == ScanLayout::kBag) {
-    throw InputError(run.settings.path +
-                     ": boicp.client.submit uploads scan files; submit a bag with `boicp submit "
-                     "BAG`");
-  }
   {
     py::gil_scoped_release release;
     CheckScansLoad(run.batch.scans, AvailableCores());
@@ -180,6 +200,7 @@ py::dict PlanSubmission(const py::object& scans, const py::dict& settings) {
   out["request"] = py::bytes(
       cli::BuildSubmitRequest(run, label.empty() ? default_label : label).SerializeAsString());
   out["scans"] = uploads;
+  out["read"] = PlannedScanBytes(run.batch.scans);
   out["description"] = run.description;
   return out;
 }
@@ -211,10 +232,14 @@ PYBIND11_MODULE(_boicp, m) {
   m.def("build_map", &BuildMap, py::arg("folder"), py::arg("out_dir"), py::arg("settings"),
         py::arg("threads"), py::arg("max_fusion_mb"), py::arg("progress"));
 #ifdef BOICP_WITH_REMOTE_COMMANDS
+  py::class_<PlannedScanBytes>(m, "PlannedScanBytes",
+                               "read(i): the bytes planned scan i is uploaded as.")
+      .def("__call__", &PlannedScanBytes::Read, py::arg("index"))
+      .def("__len__", &PlannedScanBytes::size);
   m.def("plan_submission", &PlanSubmission, py::arg("scans"), py::arg("settings"),
-        "The batch request and the scans' upload metadata `boicp submit` would send for "
-        "`scans` (a folder, or a list of scan files) with `settings` (by name, as build_map "
-        "takes them; 'label' too).");
+        "The batch request, the scans' upload metadata and a reader of their bytes, as "
+        "`boicp submit` would send them for `scans` (a folder or a bag, or a list of scan "
+        "files) with `settings` (by name, as build_map takes them; 'label' too).");
 #endif
 }
 

@@ -110,8 +110,7 @@ v1::UploadScanResponse MapBuilderClient::UploadFile(const std::string& path,
 
 v1::UploadScanResponse MapBuilderClient::UploadScan(const ScanSource& scan,
                                                     const v1::ScanMetadata& metadata) {
-  if (scan.load.format != CloudFormat::kRosMessage) return UploadFile(scan.path, metadata);
-  return Upload(EncodeBinaryPcd(LoadPointCloud(scan.path, scan.load).points), metadata);
+  return Upload(ScanUploadBytes(scan), metadata);
 }
 
 v1::Job MapBuilderClient::Submit(const v1::SubmitBatchRequest& request) {
@@ -236,6 +235,11 @@ std::string ScanId(const std::string& bytes) {
   Sha256 hash;
   hash.Update(bytes.data(), bytes.size());
   return hash.HexDigest();
+}
+
+std::string ScanUploadBytes(const ScanSource& scan) {
+  if (scan.load.format != CloudFormat::kRosMessage) return ReadAll(scan.path);
+  return EncodeBinaryPcd(LoadPointCloud(scan.path, scan.load).points);
 }
 
 }  // namespace boicp::rpc

@@ -165,9 +165,21 @@ class BagCli : public ::testing::Test {
     return contents;
   }
 
+  // The drive as a ROS 2 .db3 folder split in two files, as rosbag2 splits
+  // a bag by size.
+  fs::path WriteSplitRos2Bag() const {
+    test::BagTestContents first = Ros2Contents({}), second = first;
+    const size_t half = first.messages.size() / 2;
+    first.messages.resize(half);
+    second.messages.erase(second.messages.begin(), second.messages.begin() + half);
+    const fs::path folder = test::WriteRos2SqliteBag(dir_ / "drive_split", first).parent_path();
+    fs::rename(test::WriteRos2SqliteBag(dir_ / "split_part", second), folder / "drive_split_1.db3");
+    return folder;
+  }
+
   // `boicp map` on a ROS 1 bag (lz4 chunks), a ROS 2 .db3 folder (float64
-  // points) and a ROS 2 .mcap file (zstd chunks) of the drive gives the
-  // trajectory of the folder of its scans, byte for byte.
+  // points), one split in two files and a ROS 2 .mcap file (zstd chunks) of
+  // the drive gives the trajectory of the folder of its scans, byte for byte.
   void ExpectEveryBagGivesTheFoldersTrajectory();
 
   fs::path dir_;
@@ -192,6 +204,7 @@ void BagCli::ExpectEveryBagGivesTheFoldersTrajectory() {
       {"ros1-lz4", WriteRos1Bag(test::Ros1BagCompression::kLz4)},
       {"ros2-db3-folder",
        test::WriteRos2SqliteBag(dir_ / "drive_db3", Ros2Contents(float64)).parent_path()},
+      {"ros2-db3-split", WriteSplitRos2Bag()},
       {"ros2-mcap-zstd", dir_ / "drive.mcap"},
   };
   test::WriteMcap(dir_ / "drive.mcap", Ros2Contents({}), zstd);

@@ -15,6 +15,7 @@ import pathlib
 import random
 import re
 import shutil
+import sqlite3
 import struct
 import subprocess
 import sys
@@ -161,6 +162,7 @@ def fake_planner(calls):
                                               timestamp=float(index)).SerializeToString()}
                  for index, path in enumerate(paths)]
         return {"request": request.SerializeToString(), "scans": scans,
+                "read": lambda index: pathlib.Path(paths[index]).read_bytes(),
                 "description": f"{len(paths)} scans (fake plan)"}
 
     module = types.ModuleType("boicp._boicp")
@@ -389,6 +391,77 @@ def test_submit_with_the_real_plan(daemon, scan_folder, listed):
     assert events[-1].job.label == str(scan_folder / "velodyne" if listed else scan_folder)
     assert [(p.source, p.target) for p in results.pairs] == [(0, 1)]
     assert len(results.trajectory) == 2
+    assert results.pairs[0].transform.m[3] == pytest.approx(-SHIFT_X, abs=0.05)
+
+
+class Cdr:
+    """Little-endian CDR as ROS 2 serialises a message: the encapsulation
+    header, then each primitive aligned to its size from after the header."""
+
+    def __init__(self):
+        self.data = bytearray(b"\x00\x01\x00\x00")
+
+    def primitive(self, fmt, value):
+        size = struct.calcsize(fmt)
+        self.data += bytes(-(len(self.data) - 4) % size)
+        self.data += struct.pack("<" + fmt, value)
+
+    def string(self, text):
+        self.primitive("I", len(text) + 1)
+        self.data += text.encode() + b"\x00"
+
+
+def point_cloud2(kitti_bin, stamp_s):
+    """sensor_msgs/msg/PointCloud2 of KITTI .bin points (x, y, z, intensity as float32)."""
+    message = Cdr()
+    message.primitive("i", stamp_s)
+    message.primitive("I", 0)
+    message.string("velodyne")
+    message.primitive("I", 1)  # height
+    message.primitive("I", len(kitti_bin) // 16)  # width
+    message.primitive("I", 4)
+    for offset, name in enumerate(["x", "y", "z", "intensity"]):
+        message.string(name)
+        message.primitive("I", 4 * offset)
+        message.primitive("B", 7)  # FLOAT32
+        message.primitive("I", 1)
+    message.primitive("B", 0)  # is_bigendian
+    message.primitive("I", 16)  # point_step
+    message.primitive("I", len(kitti_bin))  # row_step
+    message.primitive("I", len(kitti_bin))
+    message.data += kitti_bin
+    message.primitive("B", 1)  # is_dense
+    return bytes(message.data)
+
+
+def ros2_bag(path, clouds):
+    """A rosbag2 sqlite3 file with one PointCloud2 topic, a message a second."""
+    with contextlib.closing(sqlite3.connect(path)) as db, db:
+        db.executescript(
+            "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL,"
+            " serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);"
+            "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL,"
+            " timestamp INTEGER NOT NULL, data BLOB NOT NULL);")
+        db.execute("INSERT INTO topics VALUES (1, '/points', 'sensor_msgs/msg/PointCloud2',"
+                   " 'cdr', '')")
+        for index, cloud in enumerate(clouds):
+            db.execute("INSERT INTO messages (topic_id, timestamp, data) VALUES (1, ?, ?)",
+                       ((index + 1) * 10**9, point_cloud2(cloud, index + 1)))
+    return path
+
+
+def test_submit_uploads_a_bags_scans_and_maps_them(daemon, tmp_path):
+    pytest.importorskip("boicp._boicp", reason="boicp._boicp is not built")
+    bag = ros2_bag(tmp_path / "drive.db3", [street_scan(i * SHIFT_X, i) for i in range(2)])
+    progress = []
+    with Client(daemon.address) as c:
+        job_id = c.submit(bag, config="A", random_samples=4, iterations=4, seed=3, resolution=0.3,
+                          progress=lambda *p: progress.append(p))
+        events = watch_to_end(c, job_id)
+        assert events[-1].job.state == pb.JOB_STATE_SUCCEEDED, daemon.log()
+        results = c.results(job_id)
+    assert [p[:2] for p in progress] == [(1, 2), (2, 2)]
+    assert [(p.source, p.target) for p in results.pairs] == [(0, 1)]
     assert results.pairs[0].transform.m[3] == pytest.approx(-SHIFT_X, abs=0.05)
 
 

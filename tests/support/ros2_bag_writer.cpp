@@ -356,7 +356,15 @@ McapLayout WriteMcap(const fs::path& file, const BagTestContents& contents,
       out += SummaryOffset(0x08, chunk_indexes_at, chunks.chunk_indexes.size());
     }
   }
-  out += mcap::Footer(layout.summary_start, summary_offsets_at) + mcap::Magic();
+  // As the mcap library writes it: the CRC of the summary section and of the
+  // footer up to the CRC field.
+  uint32_t summary_crc = 0;
+  if (options.summary) {
+    const std::string footer = mcap::Footer(layout.summary_start, summary_offsets_at);
+    summary_crc =
+        mcap::Crc32(out.substr(layout.summary_start) + footer.substr(0, footer.size() - 4));
+  }
+  out += mcap::Footer(layout.summary_start, summary_offsets_at, summary_crc) + mcap::Magic();
   WriteBytes(file, out);
   return layout;
 }
@@ -422,8 +430,8 @@ uint32_t Crc32(const std::string& bytes) {
 
 std::string DataEnd() { return Record(0x0F, U32(0)); }
 
-std::string Footer(uint64_t summary_start, uint64_t summary_offset_start) {
-  return Record(0x02, U64(summary_start) + U64(summary_offset_start) + U32(0));
+std::string Footer(uint64_t summary_start, uint64_t summary_offset_start, uint32_t summary_crc) {
+  return Record(0x02, U64(summary_start) + U64(summary_offset_start) + U32(summary_crc));
 }
 
 std::string Zstd(const std::string& bytes) {

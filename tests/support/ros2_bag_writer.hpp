@@ -92,7 +92,9 @@ std::string Chunk(const std::string& compression, const std::string& records,
 /// The CRC-32 MCAP stores for `bytes`.
 uint32_t Crc32(const std::string& bytes);
 std::string DataEnd();
-std::string Footer(uint64_t summary_start = 0, uint64_t summary_offset_start = 0);
+/// `summary_crc` 0 = none (what a writer stores when it computed no CRC).
+std::string Footer(uint64_t summary_start = 0, uint64_t summary_offset_start = 0,
+                   uint32_t summary_crc = 0);
 std::string Zstd(const std::string& bytes);
 std::string Lz4Frame(const std::string& bytes);
 }  // namespace mcap

@@ -114,6 +114,97 @@ TEST(Ros2SqliteBag, FolderReadsBackWhatWasWritten) {
   ExpectDriveContents(*OpenBag(db3.string()));  // the .db3 file itself
 }
 
+// The drive's messages split over storage files as rosbag2 splits a bag by
+// size: every file lists every topic, each holds a run of the messages.
+std::vector<BagTestContents> SplitDrive(const std::vector<size_t>& ends) {
+  const BagTestContents whole = DriveContents();
+  std::vector<BagTestContents> parts;
+  size_t begin = 0;
+  for (size_t end : ends) {
+    BagTestContents part;
+    part.topics = whole.topics;
+    part.messages.assign(whole.messages.begin() + begin, whole.messages.begin() + end);
+    parts.push_back(part);
+    begin = end;
+  }
+  return parts;
+}
+
+// Writes `parts` as one bag folder `folder` (NAME_0, NAME_1, ... storage
+// files beside one metadata.yaml) with `write` (WriteRos2SqliteBag or
+// WriteRos2McapBag); returns the storage files in order.
+template <typename Write>
+std::vector<fs::path> WriteSplitBag(const fs::path& folder,
+                                    const std::vector<BagTestContents>& parts, Write write) {
+  std::vector<fs::path> files;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const fs::path staging = folder.parent_path() / ("part" + std::to_string(i));
+    const fs::path written = write(staging, parts[i]);
+    fs::create_directories(folder);
+    if (i == 0) fs::copy_file(staging / "metadata.yaml", folder / "metadata.yaml");
+    files.push_back(folder / (folder.filename().string() + "_" + std::to_string(i) +
+                              written.extension().string()));
+    fs::rename(written, files.back());
+    fs::remove_all(staging);
+  }
+  return files;
+}
+
+// A split bag reads as the whole one: counts added, messages merged by log
+// time with ties in file order (the /points tie at 300 spans two files), and
+// each read from its own file. Eleven files put NAME_10 after NAME_9.
+TEST(Ros2SplitBag, ReadsAsOneBagWhateverTheStorage) {
+  test::ScratchDir dir("bag_split");
+  const auto sqlite = [](const fs::path& f, const BagTestContents& c) {
+    return test::WriteRos2SqliteBag(f, c);
+  };
+  const auto mcap = [](const fs::path& f, const BagTestContents& c) {
+    return test::WriteRos2McapBag(f, c);
+  };
+  for (const std::string storage : {"db3", "mcap"}) {
+    const fs::path folder = dir.path() / storage / "drive";
+    const auto parts = SplitDrive({4, 7});
+    const auto files = storage == "db3" ? WriteSplitBag(folder, parts, sqlite)
+                                        : WriteSplitBag(folder, parts, mcap);
+    std::unique_ptr<BagReader> bag = OpenBag(folder.string());
+    EXPECT_EQ(bag->path(), folder.string());
+    ExpectDriveContents(*bag);
+    const std::vector<BagMessageRef> points = bag->Messages("/points");
+    ASSERT_EQ(points.size(), 4u);
+    EXPECT_EQ(points[0].file, 1u);  // logged at 50, written last
+    EXPECT_EQ(points[2].file, 0u);
+    EXPECT_EQ(points[3].file, 1u);
+  }
+  // The two messages of the /points tie in files 2 and 10 of eleven: file 2's
+  // comes first, as rosbag2 wrote it (a name sort would put drive_10 first).
+  const BagTestContents whole = DriveContents();
+  std::vector<BagTestContents> parts(11, BagTestContents{whole.topics, {}});
+  for (size_t i : {1, 2, 3, 5, 6}) parts[0].messages.push_back(whole.messages[i]);
+  parts[2].messages = {whole.messages[4]};
+  parts[10].messages = {whole.messages[0]};
+  const fs::path folder = dir.path() / "eleven" / "drive";
+  WriteSplitBag(folder, parts, sqlite);
+  std::unique_ptr<BagReader> bag = OpenBag(folder.string());
+  const std::vector<BagMessageRef> points = bag->Messages("/points");
+  ASSERT_EQ(points.size(), 4u);
+  EXPECT_EQ(points[2].file, 2u);
+  EXPECT_EQ(bag->Read(points[2]), Payload(5, 3));
+  EXPECT_EQ(points[3].file, 10u);
+  EXPECT_EQ(bag->Read(points[3]), Payload(1, 40));
+}
+
+TEST(Ros2SplitBag, RefusesATopicWhoseTypeChangesBetweenFiles) {
+  test::ScratchDir dir("bag_split");
+  std::vector<BagTestContents> parts = SplitDrive({4, 7});
+  parts[1].topics[1].type = "sensor_msgs/msg/NavSatFix";
+  const fs::path folder = dir.path() / "drive";
+  WriteSplitBag(folder, parts, [](const fs::path& f, const BagTestContents& c) {
+    return test::WriteRos2SqliteBag(f, c);
+  });
+  EXPECT_THAT(InputErrorMessage([&] { OpenBag(folder.string())->Topics(); }),
+              HasSubstr("topic /imu holds sensor_msgs/msg/NavSatFix, but sensor_msgs/msg/Imu"));
+}
+
 // rosbag2's "resilient" preset records in WAL mode; reading such a bag must
 // not leave -shm/-wal files beside it (nor need to create them).
 TEST(Ros2SqliteBag, WalModeBagReadsWithoutSideFiles) {
@@ -289,6 +380,36 @@ TEST(McapBag, SummaryIndexSkipsChunksOfOtherTopics) {
     EXPECT_THAT(message, HasSubstr("skip.mcap"));
     EXPECT_THAT(message,
                 HasSubstr("chunk record at byte " + std::to_string(layout.chunk_offsets[1])));
+  }
+}
+
+// A summary that fails its CRC is not trusted even where it still parses
+// (here the last byte of a summary offset record, which the reader skips):
+// the file is scanned instead, so the damaged /b chunk stops /a too. With
+// the CRC intact, /a is read through the index.
+TEST(McapBag, SummaryFailingItsCrcFallsBackToTheScan) {
+  test::ScratchDir dir("bag_mcap");
+  BagTestContents contents;
+  contents.topics = {{"/a", "std_msgs/msg/String"}, {"/b", "std_msgs/msg/String"}};
+  contents.messages = {
+      {"/a", 1, Payload(1, 5)}, {"/b", 2, Payload(2, 5)}, {"/a", 3, Payload(3, 5)}};
+  for (bool damaged_summary : {false, true}) {
+    const fs::path file = dir.path() / "crc.mcap";
+    McapWriteOptions options;
+    options.messages_per_chunk = 1;
+    const test::McapLayout layout = test::WriteMcap(file, contents, options);
+    std::string bytes = test::ReadBytes(file);
+    bytes.replace(layout.chunk_offsets[1] + 9 + 32, 8, test::mcap::U64(UINT64_MAX));
+    const size_t footer_at = bytes.size() - (9 + 20 + 8);
+    if (damaged_summary) bytes[footer_at - 1] = static_cast<char>(bytes[footer_at - 1] ^ 0x40);
+    test::WriteBytes(file, bytes);
+
+    std::unique_ptr<BagReader> bag = OpenBag(file.string());
+    if (damaged_summary) {
+      EXPECT_THAT(InputErrorMessage([&] { bag->Messages("/a"); }), HasSubstr("crc.mcap"));
+    } else {
+      ASSERT_EQ(bag->Messages("/a").size(), 2u);
+    }
   }
 }
 

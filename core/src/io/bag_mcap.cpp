@@ -565,6 +565,14 @@ class McapBag final : public BagReader {
     if (summary_at < kMagicSize || summary_at >= footer_at) return std::nullopt;
     RequireWithinLimit(footer_at - summary_at, At(kFooter, footer_at), "a summary section");
     const std::vector<uint8_t> records = file_.ReadAt(summary_at, footer_at - summary_at);
+    // The CRC covers the summary and the footer up to the CRC field; 0 = none.
+    const size_t crc_at = kRecordHeaderSize + 16;
+    const auto stored_crc = static_cast<uint32_t>(LoadLittleEndian(&footer[crc_at], 4));
+    if (stored_crc != 0) {
+      uLong crc = crc32_z(0, records.data(), records.size());
+      crc = crc32_z(crc, footer.data(), crc_at);
+      if (static_cast<uint32_t>(crc) != stored_crc) return std::nullopt;
+    }
     Summary summary;
     bool has_statistics = false;
     uint64_t chunk_count = 0;

@@ -40,8 +40,9 @@ std::string StorageIdentifier(const fs::path& metadata) {
   return "";
 }
 
-// The one storage file of a ROS 2 bag folder, with the extension its metadata names.
-fs::path FolderStorageFile(const fs::path& folder) {
+// The storage files of a ROS 2 bag folder, with the extension its metadata
+// names, in rosbag2's order (NAME_0, NAME_1, ..., NAME_10: shorter names first).
+std::vector<fs::path> FolderStorageFiles(const fs::path& folder) {
   const std::string identifier = StorageIdentifier(folder / "metadata.yaml");
   std::string extension;
   if (identifier == "sqlite3") extension = ".db3";
@@ -58,11 +59,21 @@ fs::path FolderStorageFile(const fs::path& folder) {
   }
   if (files.empty())
     throw InputError(folder.string() + ": no " + extension + " file beside metadata.yaml");
-  if (files.size() > 1) {
-    throw InputError(folder.string() + ": the bag is split into " + std::to_string(files.size()) +
-                     " " + extension + " files; give one of them as the path");
-  }
-  return files.front();
+  std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
+    const std::string x = a.filename().string(), y = b.filename().string();
+    return std::make_pair(x.size(), x) < std::make_pair(y.size(), y);
+  });
+  return files;
+}
+
+std::unique_ptr<BagReader> OpenStorageFile(const fs::path& file, const BagLimits& limits) {
+  std::error_code error;
+  if (!fs::exists(file, error)) throw InputError(file.string() + ": no such file");
+  const std::string ext = LowerExtension(file);
+  if (ext == ".bag") return io_detail::OpenRos1Bag(file.string(), limits);
+  if (ext == ".db3") return io_detail::OpenRos2SqliteBag(file.string(), limits);
+  if (ext == ".mcap") return io_detail::OpenMcapBag(file.string(), limits);
+  throw InputError(file.string() + ": not a bag (.bag, .db3, .mcap, or a ROS 2 bag folder)");
 }
 
 }  // namespace
@@ -89,19 +100,15 @@ bool IsBagPath(const std::string& path) {
 
 std::unique_ptr<BagReader> OpenBag(const std::string& path, const BagLimits& limits) {
   std::error_code error;
-  fs::path file = path;
-  if (fs::is_directory(file, error)) {
-    if (!fs::is_regular_file(file / "metadata.yaml", error)) {
-      throw InputError(path + ": a folder without metadata.yaml is not a ROS 2 bag");
-    }
-    file = FolderStorageFile(file);
+  if (!fs::is_directory(path, error)) return OpenStorageFile(path, limits);
+  if (!fs::is_regular_file(fs::path(path) / "metadata.yaml", error)) {
+    throw InputError(path + ": a folder without metadata.yaml is not a ROS 2 bag");
   }
-  if (!fs::exists(file, error)) throw InputError(file.string() + ": no such file");
-  const std::string ext = LowerExtension(file);
-  if (ext == ".bag") return io_detail::OpenRos1Bag(file.string(), limits);
-  if (ext == ".db3") return io_detail::OpenRos2SqliteBag(file.string(), limits);
-  if (ext == ".mcap") return io_detail::OpenMcapBag(file.string(), limits);
-  throw InputError(file.string() + ": not a bag (.bag, .db3, .mcap, or a ROS 2 bag folder)");
+  const std::vector<fs::path> files = FolderStorageFiles(path);
+  if (files.size() == 1) return OpenStorageFile(files.front(), limits);
+  std::vector<std::unique_ptr<BagReader>> parts;
+  for (const fs::path& file : files) parts.push_back(OpenStorageFile(file, limits));
+  return io_detail::OpenSplitBag(path, std::move(parts));
 }
 
 }  // namespace boicp

@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "boicp/io/bag_reader.hpp"
 
@@ -16,5 +17,11 @@ std::unique_ptr<BagReader> OpenRos2SqliteBag(const std::string& path, const BagL
 
 /// A ROS 2 .mcap file, chunked or not, with or without a summary section.
 std::unique_ptr<BagReader> OpenMcapBag(const std::string& path, const BagLimits& limits);
+
+/// A ROS 2 bag `folder` split into `parts` (its storage files in order, at
+/// least one) as one bag. Throws InputError when a topic's type differs
+/// between parts.
+std::unique_ptr<BagReader> OpenSplitBag(const std::string& folder,
+                                        std::vector<std::unique_ptr<BagReader>> parts);
 
 }  // namespace boicp::io_detail

@@ -66,7 +66,7 @@ uint64_t DepthPngBound(const std::string& path, uint64_t max_points) {
 }  // namespace
 
 uint64_t DecodeBoundBytes(const std::string& path, const LoadOptions& options) {
-  io_detail::RequireReadableFile(path);
+  if (options.format != CloudFormat::kRosMessage) io_detail::RequireReadableFile(path);
   const CloudFormat format =
       options.format == CloudFormat::kAuto ? DetectCloudFormat(path) : options.format;
   const uint64_t limit = options.max_points;

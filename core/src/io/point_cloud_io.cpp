@@ -111,7 +111,8 @@ CloudFormat DetectCloudFormat(const std::string& path) {
 }
 
 LoadedCloud LoadPointCloud(const std::string& path, const LoadOptions& options) {
-  io_detail::RequireReadableFile(path);
+  // A message's bag may be a folder (a split ROS 2 bag); OpenBag checks it.
+  if (options.format != CloudFormat::kRosMessage) io_detail::RequireReadableFile(path);
   LoadedCloud cloud;
   cloud.format = options.format == CloudFormat::kAuto ? DetectCloudFormat(path) : options.format;
   if (options.decode_budget != nullptr) {

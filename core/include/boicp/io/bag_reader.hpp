@@ -35,6 +35,7 @@ struct BagMessageRef {
   uint64_t position = 0;    // the reader's own locator
   uint64_t offset = 0;      // the reader's own locator
   uint64_t size = 0;        // serialized bytes, as the bag declares them
+  uint32_t file = 0;        // which storage file of a split ROS 2 bag holds it
 };
 
 /// Limits applied before anything is allocated from a size the file declares.
@@ -68,7 +69,8 @@ class BagReader {
 bool IsBagPath(const std::string& path);
 
 /// Opens a bag, its storage from the path as IsBagPath tells it (a ROS 2
-/// folder: its metadata.yaml's storage_identifier, sqlite3 or mcap). Throws
+/// folder: its metadata.yaml's storage_identifier, sqlite3 or mcap; a folder
+/// split into several storage files reads as one bag). Throws
 /// InputError naming the file and the problem (missing, not a bag, truncated,
 /// an unsupported compression or storage).
 std::unique_ptr<BagReader> OpenBag(const std::string& path, const BagLimits& limits = {});

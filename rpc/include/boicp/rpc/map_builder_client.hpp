@@ -63,9 +63,7 @@ class MapBuilderClient {
                                 size_t chunk_bytes = 1 << 20);
   /// Reads the file and uploads it. Throws std::runtime_error when unreadable.
   v1::UploadScanResponse UploadFile(const std::string& path, const v1::ScanMetadata& metadata);
-  /// Uploads a scan (metadata from ScanMetadataOf): its file, or, for a scan
-  /// inside a bag, the binary PCD of its points. Throws InputError when the
-  /// scan does not load.
+  /// Uploads a scan (metadata from ScanMetadataOf): its ScanUploadBytes.
   v1::UploadScanResponse UploadScan(const ScanSource& scan, const v1::ScanMetadata& metadata);
 
   v1::Job Submit(const v1::SubmitBatchRequest& request);
@@ -96,6 +94,12 @@ class MapBuilderClient {
   std::string token_;
   std::chrono::milliseconds unary_timeout_{0};
 };
+
+/// The bytes a scan is uploaded as: its file, or for a scan inside a bag the
+/// binary PCD of its points (the format ScanMetadataOf declares). Throws
+/// std::runtime_error when a file is unreadable, InputError when a bag's
+/// scan does not load.
+std::string ScanUploadBytes(const ScanSource& scan);
 
 /// Lowercase hex SHA-256 of `bytes`, the scan id the daemon will assign.
 std::string ScanId(const std::string& bytes);
