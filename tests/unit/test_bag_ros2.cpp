@@ -348,25 +348,32 @@ TEST(McapBag, EmptyBagHasNoTimeRange) {
   }
 }
 
-// With a summary, a topic's messages come from the chunks its index lists:
-// a damaged chunk holding only another topic is never read.
-TEST(McapBag, SummaryIndexSkipsChunksOfOtherTopics) {
-  test::ScratchDir dir("bag_mcap");
+// Messages on /a, /b and /a, a chunk each, written to `file` (with a summary
+// or not) and then the /b chunk damaged: its records length, after the fixed
+// fields and the empty compression name, made huge.
+test::McapLayout WriteMcapWithADamagedChunk(const fs::path& file, bool summary) {
   BagTestContents contents;
   contents.topics = {{"/a", "std_msgs/msg/String"}, {"/b", "std_msgs/msg/String"}};
   contents.messages = {
       {"/a", 1, Payload(1, 5)}, {"/b", 2, Payload(2, 5)}, {"/a", 3, Payload(3, 5)}};
+  McapWriteOptions options;
+  options.messages_per_chunk = 1;
+  options.summary = summary;
+  const test::McapLayout layout = test::WriteMcap(file, contents, options);
+  EXPECT_EQ(layout.chunk_offsets.size(), 3u);
+  std::string bytes = test::ReadBytes(file);
+  bytes.replace(layout.chunk_offsets.at(1) + 9 + 32, 8, test::mcap::U64(UINT64_MAX));
+  test::WriteBytes(file, bytes);
+  return layout;
+}
+
+// With a summary, a topic's messages come from the chunks its index lists:
+// a damaged chunk holding only another topic is never read.
+TEST(McapBag, SummaryIndexSkipsChunksOfOtherTopics) {
+  test::ScratchDir dir("bag_mcap");
   for (bool summary : {true, false}) {
     const fs::path file = dir.path() / "skip.mcap";
-    McapWriteOptions options;
-    options.messages_per_chunk = 1;
-    options.summary = summary;
-    const test::McapLayout layout = test::WriteMcap(file, contents, options);
-    ASSERT_EQ(layout.chunk_offsets.size(), 3u);
-    // The /b chunk's records length (after the fixed fields and the empty compression name).
-    std::string bytes = test::ReadBytes(file);
-    bytes.replace(layout.chunk_offsets[1] + 9 + 32, 8, test::mcap::U64(UINT64_MAX));
-    test::WriteBytes(file, bytes);
+    const test::McapLayout layout = WriteMcapWithADamagedChunk(file, summary);
 
     std::unique_ptr<BagReader> bag = OpenBag(file.string());
     if (summary) {
@@ -389,20 +396,15 @@ TEST(McapBag, SummaryIndexSkipsChunksOfOtherTopics) {
 // the CRC intact, /a is read through the index.
 TEST(McapBag, SummaryFailingItsCrcFallsBackToTheScan) {
   test::ScratchDir dir("bag_mcap");
-  BagTestContents contents;
-  contents.topics = {{"/a", "std_msgs/msg/String"}, {"/b", "std_msgs/msg/String"}};
-  contents.messages = {
-      {"/a", 1, Payload(1, 5)}, {"/b", 2, Payload(2, 5)}, {"/a", 3, Payload(3, 5)}};
   for (bool damaged_summary : {false, true}) {
     const fs::path file = dir.path() / "crc.mcap";
-    McapWriteOptions options;
-    options.messages_per_chunk = 1;
-    const test::McapLayout layout = test::WriteMcap(file, contents, options);
-    std::string bytes = test::ReadBytes(file);
-    bytes.replace(layout.chunk_offsets[1] + 9 + 32, 8, test::mcap::U64(UINT64_MAX));
-    const size_t footer_at = bytes.size() - (9 + 20 + 8);
-    if (damaged_summary) bytes[footer_at - 1] = static_cast<char>(bytes[footer_at - 1] ^ 0x40);
-    test::WriteBytes(file, bytes);
+    WriteMcapWithADamagedChunk(file, true);
+    if (damaged_summary) {
+      std::string bytes = test::ReadBytes(file);
+      const size_t footer_at = bytes.size() - (9 + 20 + 8);
+      bytes[footer_at - 1] = static_cast<char>(bytes[footer_at - 1] ^ 0x40);
+      test::WriteBytes(file, bytes);
+    }
 
     std::unique_ptr<BagReader> bag = OpenBag(file.string());
     if (damaged_summary) {
