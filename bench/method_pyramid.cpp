@@ -107,7 +107,11 @@ void SortByFit(std::vector<Candidate>& candidates) {
 
 std::vector<Candidate> PyramidStage(const SearchSpace& space, GridScorer& scorer,
                                     const PyramidBudget& budget) {
-  const std::vector<bool> periodic = space.Periodic();
+  const KernelInputs inputs = space.Inputs();  // an Euler-angle box
+  std::vector<bool> periodic;
+  for (int k = 0; k < inputs.dimension(); ++k) {
+    periodic.push_back(inputs[k] == InputKind::kPeriodic);
+  }
   const Eigen::VectorXd middle = Eigen::VectorXd::Constant(space.dimension(), 0.5);
   std::vector<Candidate> coarse = Grid(middle, 0.5, budget.initial_per_axis, periodic);
   scorer.Score(space, coarse);

@@ -93,6 +93,15 @@ const std::vector<BenchMethod>& BenchMethods() {
        Fixed("core RegisterPair, preset C (N_r 30, N 60, dataset voxel), nested")},
       {"bo-C-6dof", "bo-icp", [](const MethodInput& in) { return PaperSearch("C", true, in); },
        true, Fixed("core RegisterPair, preset C, one 6-DOF search (N_r 30, N 60)")},
+      {"bo-C-so3", "bo-icp",
+       [](const MethodInput& in) {
+         BoIcpConfig config = PaperSearch("C", false, in);
+         config.rotation_coordinates = RotationCoordinates::kRotationVector;
+         return config;
+       },
+       true,
+       Fixed("core RegisterPair, preset C as bo-C, but a box holding every rotation is searched "
+             "as rotation vectors (uniform initial rotations, geodesic kernel)")},
       {"bo-C-auto", "bo-icp", DatasetAutoConfig, true,
        Fixed("core RegisterPair as `boicp register` runs it with no flags: preset C, settings "
              "chosen from the pair, the escalation ladder (features, short search, full search, "

@@ -1,5 +1,6 @@
 #include "boicp/bo/gaussian_process.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -108,6 +109,26 @@ TEST(GaussianProcessTest, PeriodicDimensionJoinsItsEnds) {
   }
 }
 
+// The analytic gradient against central differences at theta.
+void ExpectGradientMatchesFiniteDifferences(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                            const KernelInputs& inputs,
+                                            const Eigen::VectorXd& theta) {
+  Eigen::VectorXd gradient;
+  GpLogMarginalLikelihood(X, y, inputs, theta, &gradient);
+  ASSERT_EQ(gradient.size(), theta.size());
+  for (Eigen::Index k = 0; k < theta.size(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd plus = theta, minus = theta;
+    plus(k) += h;
+    minus(k) -= h;
+    const double numeric = (GpLogMarginalLikelihood(X, y, inputs, plus, nullptr) -
+                            GpLogMarginalLikelihood(X, y, inputs, minus, nullptr)) /
+                           (2.0 * h);
+    EXPECT_NEAR(gradient(k), numeric, 1e-5 * std::max(1.0, std::abs(numeric)))
+        << "parameter " << k << " at theta " << theta.transpose();
+  }
+}
+
 TEST(GaussianProcessTest, LikelihoodGradientMatchesFiniteDifferences) {
   std::mt19937_64 rng(11);
   const std::vector<bool> periodic = {false, true, false};
@@ -126,21 +147,30 @@ TEST(GaussianProcessTest, LikelihoodGradientMatchesFiniteDifferences) {
        std::log(1e-5))
           .finished()};
   for (const Eigen::VectorXd& theta : thetas) {
-    Eigen::VectorXd gradient;
-    GpLogMarginalLikelihood(X, y, periodic, theta, &gradient);
-    ASSERT_EQ(gradient.size(), theta.size());
-    for (Eigen::Index k = 0; k < theta.size(); ++k) {
-      const double h = 1e-6;
-      Eigen::VectorXd plus = theta, minus = theta;
-      plus(k) += h;
-      minus(k) -= h;
-      const double numeric = (GpLogMarginalLikelihood(X, y, periodic, plus, nullptr) -
-                              GpLogMarginalLikelihood(X, y, periodic, minus, nullptr)) /
-                             (2.0 * h);
-      EXPECT_NEAR(gradient(k), numeric, 1e-5 * std::max(1.0, std::abs(numeric)))
-          << "parameter " << k << " at theta " << theta.transpose();
-    }
+    ExpectGradientMatchesFiniteDifferences(X, y, periodic, theta);
   }
+}
+
+// A rotation's second and third length scales are tied to its first, so
+// their derivatives are zero.
+TEST(GaussianProcessTest, RotationLikelihoodGradientMatchesFiniteDifferences) {
+  std::mt19937_64 rng(11);
+  const KernelInputs inputs(
+      {InputKind::kRotation, InputKind::kRotation, InputKind::kRotation, InputKind::kLinear});
+  const Eigen::MatrixXd X = UniformPoints(15, 4, rng);
+  Eigen::VectorXd y(X.rows());
+  for (Eigen::Index i = 0; i < X.rows(); ++i) {
+    const Eigen::Matrix3d R = RotationFromUnit(X.row(i).head<3>().transpose());
+    y(i) = R(0, 0) + 0.5 * R(2, 1) + X(i, 3) + 0.1 * UniformUnit(rng);
+  }
+  const Eigen::VectorXd theta = (Eigen::VectorXd(6) << std::log(0.2), std::log(0.7), std::log(3.0),
+                                 std::log(0.4), std::log(1.5), std::log(1e-3))
+                                    .finished();
+  ExpectGradientMatchesFiniteDifferences(X, y, inputs, theta);
+  Eigen::VectorXd gradient;
+  GpLogMarginalLikelihood(X, y, inputs, theta, &gradient);
+  EXPECT_EQ(gradient(1), 0.0);
+  EXPECT_EQ(gradient(2), 0.0);
 }
 
 TEST(GaussianProcessTest, PredictBatchMatchesPredict) {

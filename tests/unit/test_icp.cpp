@@ -253,7 +253,7 @@ TEST(SearchSpace, CentreIsTheAnchorAndRollYawWrap) {
       MakeSearchSpace(anchor, Point(1, 2, 3), {M_PI, M_PI / 2, M_PI}, Eigen::Vector3d::Zero());
   ASSERT_EQ(space.dimension(), 3);
   EXPECT_TRUE(space.ToTransform(Eigen::Vector3d::Constant(0.5)).isApprox(anchor, 1e-12));
-  EXPECT_EQ(space.Periodic(), (std::vector<bool>{true, false, true}));
+  EXPECT_EQ(space.Inputs(), KernelInputs({true, false, true}));
   // u = 0 and u = 1 on roll and yaw are the same rotation (-pi == +pi).
   const Transform low = space.ToTransform(Eigen::Vector3d(0.0, 0.3, 0.0));
   const Transform high = space.ToTransform(Eigen::Vector3d(1.0, 0.3, 1.0));

@@ -18,9 +18,9 @@ void RequireValidOptions(bool ok, const std::string& message) {
   if (!ok) throw InputError("BayesOptOptions: " + message);
 }
 
-void ValidateOptions(const BayesOptOptions& o, const std::vector<bool>& periodic) {
-  RequireValidOptions(!periodic.empty(),
-                      "the search space needs at least one dimension (periodic is empty)");
+void ValidateOptions(const BayesOptOptions& o, const KernelInputs& inputs) {
+  RequireValidOptions(!inputs.empty(),
+                      "the search space needs at least one dimension (inputs is empty)");
   RequireValidOptions(o.initial_samples >= 1,
                       "initial_samples must be >= 1, got " + std::to_string(o.initial_samples));
   RequireValidOptions(o.iterations >= 0,
@@ -48,9 +48,11 @@ void ValidateOptions(const BayesOptOptions& o, const std::vector<bool>& periodic
 }
 
 // initial_points (clamped into the box) followed by Latin-hypercube rows up to
-// initial_samples in total.
+// initial_samples in total, whose rotation coordinates are uniform rotations.
 std::vector<Eigen::VectorXd> InitialDesign(const std::vector<Eigen::VectorXd>& initial_points,
-                                           int initial_samples, int d, std::mt19937_64& rng) {
+                                           int initial_samples, const KernelInputs& inputs,
+                                           std::mt19937_64& rng) {
+  const int d = inputs.dimension();
   std::vector<Eigen::VectorXd> design;
   for (size_t i = 0; i < initial_points.size(); ++i) {
     const Eigen::VectorXd& x = initial_points[i];
@@ -62,7 +64,10 @@ std::vector<Eigen::VectorXd> InitialDesign(const std::vector<Eigen::VectorXd>& i
   }
   const int missing = initial_samples - static_cast<int>(design.size());
   if (missing > 0) {
-    const Eigen::MatrixXd lhs = LatinHypercube(missing, d, rng);
+    Eigen::MatrixXd lhs = LatinHypercube(missing, d, rng);
+    for (int k = 0; k < d; ++k) {
+      if (inputs.StartsRotation(k)) lhs.middleCols<3>(k) = UniformRotations(missing, rng);
+    }
     for (int i = 0; i < missing; ++i) design.push_back(lhs.row(i).transpose());
   }
   return design;
@@ -195,15 +200,14 @@ std::vector<Eigen::VectorXd> ProposeRound(GaussianProcess gp,
 
 }  // namespace
 
-BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const KernelInputs& inputs,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points,
                                 const BayesOptHooks& hooks) {
-  ValidateOptions(options, periodic);
-  const auto d = static_cast<int>(periodic.size());
+  ValidateOptions(options, inputs);
   std::mt19937_64 rng(seed);
   const std::vector<Eigen::VectorXd> design =
-      InitialDesign(initial_points, options.initial_samples, d, rng);
+      InitialDesign(initial_points, options.initial_samples, inputs, rng);
   const int total = static_cast<int>(design.size()) + options.iterations;
   const auto q = static_cast<size_t>(options.batch_size);
 
@@ -217,7 +221,7 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
          design.begin() + static_cast<std::ptrdiff_t>(std::min(first + q, design.size()))});
   }
 
-  GaussianProcess gp(periodic);
+  GaussianProcess gp(inputs);
   GpHyperparameters fitted;
   bool have_fit = false;
   int since_fit = 0;
@@ -249,22 +253,22 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
   return result;
 }
 
-BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const KernelInputs& inputs,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points,
                                 const BayesOptProgress& progress,
                                 const std::function<bool()>& stop_requested) {
-  return MinimiseBayesOpt(f, periodic, options, seed, initial_points,
+  return MinimiseBayesOpt(f, inputs, options, seed, initial_points,
                           BayesOptHooks{progress, stop_requested, {}, {}});
 }
 
-BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const KernelInputs& inputs,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points,
                                 const BayesOptProgress& progress,
                                 const std::function<bool()>& stop_requested) {
   const BoundedObjective unbounded = [&f](const Eigen::VectorXd& x, double) { return f(x); };
-  return MinimiseBayesOpt(unbounded, periodic, options, seed, initial_points, progress,
+  return MinimiseBayesOpt(unbounded, inputs, options, seed, initial_points, progress,
                           stop_requested);
 }
 

@@ -30,9 +30,13 @@ constexpr double kMaxFitJitter = 1e-4;
 // Condition must always succeed, so it climbs further as a last resort.
 constexpr double kMaxConditionJitter = 1.0;
 
-int EmbeddedWidth(const std::vector<bool>& periodic) {
+// A chord of R / (2 sqrt2 pi) is |du| for a small turn about one axis, whose
+// angle is 2 pi du.
+constexpr double kRotationChordScale = 1.0 / (2.0 * 1.41421356237309504880 * kPi);
+
+int EmbeddedWidth(const KernelInputs& inputs) {
   int width = 0;
-  for (bool p : periodic) width += p ? 2 : 1;
+  for (int k = 0; k < inputs.dimension(); ++k) width += inputs.EmbeddedWidth(k);
   return width;
 }
 
@@ -40,21 +44,33 @@ int EmbeddedWidth(const std::vector<bool>& periodic) {
 // distance along input dimension k is the plain sum of squares over k's
 // columns, each divided by length_scales[k]^2. Periodic u becomes
 // (cos 2 pi u, sin 2 pi u) / (2 pi): a chord that equals |du| for small du and
-// makes u = 0 and u = 1 the same point.
-Eigen::MatrixXd ScaledFeatures(const Eigen::MatrixXd& X, const std::vector<bool>& periodic,
+// makes u = 0 and u = 1 the same point. A rotation's three coordinates become
+// the nine entries of its matrix, under the first one's length scale.
+Eigen::MatrixXd ScaledFeatures(const Eigen::MatrixXd& X, const KernelInputs& inputs,
                                const Eigen::VectorXd& length_scales) {
-  const auto d = static_cast<int>(periodic.size());
-  Eigen::MatrixXd F(EmbeddedWidth(periodic), X.rows());
+  const int d = inputs.dimension();
+  Eigen::MatrixXd F(EmbeddedWidth(inputs), X.rows());
   for (Eigen::Index i = 0; i < X.rows(); ++i) {
     int c = 0;
     for (int k = 0; k < d; ++k) {
+      if (inputs.EmbeddedWidth(k) == 0) continue;
       const double inv_l = 1.0 / length_scales(k);
       const double u = X(i, k);
-      if (periodic[static_cast<size_t>(k)]) {
-        F(c++, i) = std::cos(2.0 * kPi * u) / (2.0 * kPi) * inv_l;
-        F(c++, i) = std::sin(2.0 * kPi * u) / (2.0 * kPi) * inv_l;
-      } else {
-        F(c++, i) = u * inv_l;
+      switch (inputs[k]) {
+        case InputKind::kPeriodic:
+          F(c++, i) = std::cos(2.0 * kPi * u) / (2.0 * kPi) * inv_l;
+          F(c++, i) = std::sin(2.0 * kPi * u) / (2.0 * kPi) * inv_l;
+          break;
+        case InputKind::kRotation: {
+          const Eigen::Matrix3d R = RotationFromUnit(X.row(i).segment<3>(k).transpose());
+          F.col(i).segment<9>(c) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R.data()) *
+                                   (kRotationChordScale * inv_l);
+          c += 9;
+          break;
+        }
+        case InputKind::kLinear:
+          F(c++, i) = u * inv_l;
+          break;
       }
     }
   }
@@ -64,18 +80,17 @@ Eigen::MatrixXd ScaledFeatures(const Eigen::MatrixXd& X, const std::vector<bool>
 // Per-dimension squared distances D_k(i, j) for all pairs i > j, in the order
 // (j = 0: i = 1..n-1), (j = 1: i = 2..n-1), ...; P x d with P = n(n-1)/2.
 // Computed once per Fit: the likelihood then only needs r^2 = D * l^-2.
-Eigen::MatrixXd PairwiseSquaredDistances(const Eigen::MatrixXd& X,
-                                         const std::vector<bool>& periodic) {
-  const auto d = static_cast<int>(periodic.size());
+Eigen::MatrixXd PairwiseSquaredDistances(const Eigen::MatrixXd& X, const KernelInputs& inputs) {
+  const int d = inputs.dimension();
   const Eigen::Index n = X.rows();
-  const Eigen::MatrixXd F = ScaledFeatures(X, periodic, Eigen::VectorXd::Ones(d));
+  const Eigen::MatrixXd F = ScaledFeatures(X, inputs, Eigen::VectorXd::Ones(d));
   Eigen::MatrixXd D(n * (n - 1) / 2, d);
   Eigen::Index p = 0;
   for (Eigen::Index j = 0; j < n; ++j) {
     for (Eigen::Index i = j + 1; i < n; ++i, ++p) {
       int c = 0;
       for (int k = 0; k < d; ++k) {
-        const int width = periodic[static_cast<size_t>(k)] ? 2 : 1;
+        const int width = inputs.EmbeddedWidth(k);
         D(p, k) = (F.col(i).segment(c, width) - F.col(j).segment(c, width)).squaredNorm();
         c += width;
       }
@@ -155,10 +170,9 @@ bool CholeskyWithJitter(Eigen::MatrixXd& K, double signal, double max_jitter, Ei
 // that an evaluation does no large heap allocation.
 class MarginalLikelihood {
  public:
-  MarginalLikelihood(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                     const std::vector<bool>& periodic)
+  MarginalLikelihood(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, const KernelInputs& inputs)
       : y_(y),
-        D_(PairwiseSquaredDistances(X, periodic)),
+        D_(PairwiseSquaredDistances(X, inputs)),
         K_(y.size(), y.size()),
         L_(y.size(), y.size()),
         k_pair_(D_.rows()),
@@ -373,19 +387,19 @@ double Matern52(double r) {
 }
 
 double GpLogMarginalLikelihood(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                               const std::vector<bool>& periodic, const Eigen::VectorXd& log_params,
+                               const KernelInputs& inputs, const Eigen::VectorXd& log_params,
                                Eigen::VectorXd* gradient) {
-  const auto d = static_cast<int>(periodic.size());
+  const int d = inputs.dimension();
   CheckData(X, y, d);
   if (log_params.size() != d + 2) {
     throw InputError("GpLogMarginalLikelihood: log_params must have d + 2 = " +
                      std::to_string(d + 2) + " entries");
   }
-  MarginalLikelihood likelihood(X, y, periodic);
+  MarginalLikelihood likelihood(X, y, inputs);
   return likelihood.Evaluate(log_params, gradient, kMaxFitJitter);
 }
 
-GaussianProcess::GaussianProcess(std::vector<bool> periodic) : periodic_(std::move(periodic)) {
+GaussianProcess::GaussianProcess(KernelInputs inputs) : inputs_(std::move(inputs)) {
   hyper_.length_scales = Eigen::VectorXd::Constant(dimension(), 0.3);
 }
 
@@ -402,11 +416,11 @@ void GaussianProcess::Condition(const Eigen::MatrixXd& X, const Eigen::VectorXd&
   y_scale_ = s.scale;
   const Eigen::VectorXd y_std = (y.array() - s.mean) / s.scale;
 
-  MarginalLikelihood likelihood(X, y_std, periodic_);
+  MarginalLikelihood likelihood(X, y_std, inputs_);
   log_marginal_likelihood_ = likelihood.Evaluate(Pack(h), nullptr, kMaxConditionJitter);
   hyper_ = h;
   X_ = X;
-  scaled_features_ = ScaledFeatures(X, periodic_, h.length_scales);
+  scaled_features_ = ScaledFeatures(X, inputs_, h.length_scales);
   if (likelihood.factorised()) {
     chol_lower_ = likelihood.cholesky_lower().triangularView<Eigen::Lower>();
     alpha_ = likelihood.alpha();
@@ -449,7 +463,7 @@ void GaussianProcess::Fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
   }
   first = first.cwiseMax(lower).cwiseMin(upper);
 
-  MarginalLikelihood likelihood(X, y_std, periodic_);
+  MarginalLikelihood likelihood(X, y_std, inputs_);
   FitSearch search;
   search.likelihood = &likelihood;
   search.best_theta = first;
@@ -458,7 +472,11 @@ void GaussianProcess::Fit(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
     MaximiseFromStart(RandomLogUniform(lower, upper, rng), lower, upper, options.max_evaluations,
                       search);
   }
-  Condition(X, y, UnpackHyperparameters(search.best_theta.cwiseMax(lower).cwiseMin(upper)));
+  GpHyperparameters best = UnpackHyperparameters(search.best_theta.cwiseMax(lower).cwiseMin(upper));
+  for (int k = 0; k < d; ++k) {
+    if (inputs_.TiedLengthScale(k)) best.length_scales(k) = best.length_scales(k - 1);
+  }
+  Condition(X, y, best);
 }
 
 GpPrediction GaussianProcess::Predict(const Eigen::VectorXd& x) const {
@@ -473,7 +491,7 @@ void GaussianProcess::PredictBatch(const Eigen::MatrixXd& Xs, Eigen::VectorXd& m
     throw InputError("GaussianProcess: prediction points have " + std::to_string(Xs.cols()) +
                      " columns, expected " + std::to_string(dimension()));
   }
-  const Eigen::MatrixXd Q = ScaledFeatures(Xs, periodic_, hyper_.length_scales);
+  const Eigen::MatrixXd Q = ScaledFeatures(Xs, inputs_, hyper_.length_scales);
   const Eigen::Index n = scaled_features_.cols();
   const Eigen::Index m = Xs.rows();
   // Cross-covariance k(x_i, x*_j), n x m.

@@ -1,10 +1,15 @@
 #include "boicp/bo/sampling.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
+
+#include "boicp/bo/kernel_inputs.hpp"
 
 namespace boicp {
 namespace {
@@ -37,6 +42,16 @@ void CheckShape(int n, int d, const char* what) {
   }
 }
 
+constexpr double kTwoPi = 6.28318530717958647692;
+
+// A uniform unit quaternion from three uniform numbers (Shoemake 1992).
+Eigen::Quaterniond UniformQuaternion(std::mt19937_64& rng) {
+  const double u1 = UniformUnit(rng), u2 = UniformUnit(rng), u3 = UniformUnit(rng);
+  const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+  return Eigen::Quaterniond(b * std::cos(kTwoPi * u3), a * std::sin(kTwoPi * u2),
+                            a * std::cos(kTwoPi * u2), b * std::sin(kTwoPi * u3));
+}
+
 }  // namespace
 
 double UniformUnit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
@@ -60,6 +75,24 @@ Eigen::MatrixXd LatinHypercube(int n, int d, std::mt19937_64& rng) {
     }
   }
   return X;
+}
+
+Eigen::MatrixXd UniformRotations(int n, std::mt19937_64& rng) {
+  CheckShape(n, 3, "UniformRotations");
+  // The spiral's two irrational turning rates (Alexa, "Super-Fibonacci
+  // Spirals", CVPR 2022).
+  const double phi = std::sqrt(2.0), psi = 1.533751168755204288118041;
+  const Eigen::Quaterniond turn = UniformQuaternion(rng);
+  Eigen::MatrixXd U(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double s = i + 0.5;
+    const double r = std::sqrt(s / n), R = std::sqrt(1.0 - s / n);
+    const double alpha = kTwoPi * s / phi, beta = kTwoPi * s / psi;
+    const Eigen::Quaterniond q(R * std::cos(beta), r * std::sin(alpha), r * std::cos(alpha),
+                               R * std::sin(beta));
+    U.row(i) = UnitFromRotation((turn * q).toRotationMatrix()).transpose();
+  }
+  return U;
 }
 
 }  // namespace boicp

@@ -108,6 +108,12 @@ double BoIcpConfig::EffectiveInlierDistance() const {
   return inlier_distance > 0.0 ? inlier_distance : 1.5 * EffectiveRefineVoxel();
 }
 
+RotationCoordinates BoIcpConfig::EffectiveRotationCoordinates() const {
+  return rotation_coordinates.value_or(budget == Budget::kAuto
+                                           ? RotationCoordinates::kRotationVector
+                                           : RotationCoordinates::kEulerAngles);
+}
+
 BoIcpConfig PresetConfig(const std::string& name) {
   std::string upper = name;
   std::transform(upper.begin(), upper.end(), upper.begin(),

@@ -169,7 +169,7 @@ class SearchStages {
     std::vector<Eigen::VectorXd> starts = {Eigen::VectorXd::Constant(space.dimension(), 0.5)};
     starts.insert(starts.end(), extra_starts.begin(), extra_starts.end());
     BayesOptResult result = MinimiseBayesOpt(
-        objective, space.Periodic(), options,
+        objective, space.Inputs(), options,
         config_.seed ^ (kStageSalt * static_cast<uint64_t>(stage + 1)), starts, hooks);
     AppendInProposalOrder(result.history, resumed, finished);
     return result;
@@ -370,7 +370,8 @@ int StagedSearch::evaluations() const { return static_cast<int>(search_->history
 SearchSpace StagedSearch::FirstSpace() const {
   const bool nested = config_.mode == SearchMode::kNested;
   return MakeSearchSpace(frame_.anchor, frame_.pivot, config_.rotation_bounds,
-                         nested ? Eigen::Vector3d::Zero() : config_.translation_bounds);
+                         nested ? Eigen::Vector3d::Zero() : config_.translation_bounds,
+                         config_.EffectiveRotationCoordinates());
 }
 
 void StagedSearch::Run(bool short_budget) {

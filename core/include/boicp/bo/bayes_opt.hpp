@@ -77,12 +77,13 @@ struct BayesOptHooks {
   std::vector<BayesOptSample> resume;
 };
 
-/// Minimises f over [0,1]^d with d = periodic.size(). Evaluations run in
+/// Minimises f over [0,1]^d with d = inputs.dimension(). Evaluations run in
 /// rounds of options.batch_size points (the initial design too). `initial_points` (rows in
 /// the box, for example a prior guess) replace the first Latin-hypercube
-/// samples. `stop_requested`, if set, is polled between evaluations and ends
-/// the search by throwing boicp::Cancelled. Reproducible for a given seed.
-/// f must return finite values.
+/// samples; a rotation's coordinates in those samples are spread uniformly
+/// over all rotations instead (UniformRotations). `stop_requested`, if set, is polled between
+/// evaluations and ends the search by throwing boicp::Cancelled. Reproducible for a given seed. f
+/// must return finite values.
 ///
 /// Details: if initial_points.size() >= initial_samples only the initial
 /// points are used; each is clamped into the box. The first and the final GP
@@ -94,7 +95,7 @@ struct BayesOptHooks {
 /// points and non-finite objective values (the message names the 0-based evaluation index) throw
 /// boicp::InputError. One std::mt19937_64(seed) drives every random choice, so a seed reproduces
 /// the run bit for bit.
-BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const KernelInputs& inputs,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points = {},
                                 const BayesOptProgress& progress = {},
@@ -102,13 +103,13 @@ BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<boo
 
 /// The same with every hook: an early end (hooks.enough) and the
 /// continuation of a search that ended early (hooks.resume).
-BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const BoundedObjective& f, const KernelInputs& inputs,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points,
                                 const BayesOptHooks& hooks);
 
 /// The same for an objective that always returns f(x).
-BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const std::vector<bool>& periodic,
+BayesOptResult MinimiseBayesOpt(const UnitObjective& f, const KernelInputs& inputs,
                                 const BayesOptOptions& options, uint64_t seed,
                                 const std::vector<Eigen::VectorXd>& initial_points = {},
                                 const BayesOptProgress& progress = {},

@@ -7,7 +7,10 @@
 // and u = 1 are the same rotation) enter the kernel through the embedding
 // u -> (cos 2 pi u, sin 2 pi u) / (2 pi): the kernel stays positive definite and
 // the two ends of the interval are one point, so the surrogate cannot show two
-// distinct optima for one rotation.
+// distinct optima for one rotation. A rotation vector enters as its rotation
+// matrix, R / (2 sqrt2 pi): the chord between two rotations depends on their
+// geodesic angle alone (2 sqrt2 sin(angle / 2)), and equals |du| for a small
+// turn about an axis (kernel_inputs.hpp).
 //
 // Standardisation: y is centred by its mean and divided by its population
 // standard deviation (1 when that is ~0), so hyperparameters are in units of
@@ -18,6 +21,8 @@
 
 #include <Eigen/Core>
 
+#include "boicp/bo/kernel_inputs.hpp"
+
 namespace boicp {
 
 /// Matern nu = 5/2 correlation at scaled distance r >= 0:
@@ -25,9 +30,11 @@ namespace boicp {
 double Matern52(double r);
 
 struct GpHyperparameters {
-  Eigen::VectorXd length_scales;  // one per input dimension, unit-box units
-  double signal_variance = 1.0;   // of the standardised output
-  double noise_variance = 1e-4;   // of the standardised output
+  // One per input dimension, unit-box units; a rotation's second and third
+  // are set to its first (KernelInputs::TiedLengthScale).
+  Eigen::VectorXd length_scales;
+  double signal_variance = 1.0;  // of the standardised output
+  double noise_variance = 1e-4;  // of the standardised output
 };
 
 /// Bounds and effort for maximising the log marginal likelihood.
@@ -49,11 +56,11 @@ struct GpPrediction {
 
 class GaussianProcess {
  public:
-  /// periodic[k] marks input dimension k as wrapping around (0 == 1).
-  explicit GaussianProcess(std::vector<bool> periodic);
+  /// inputs[k] says how input dimension k enters the kernel.
+  explicit GaussianProcess(KernelInputs inputs);
 
   /// Conditions on n observations: X is n x d with rows in [0,1]^d, y has n
-  /// finite entries. Preconditions: n >= 1, X.cols() == periodic.size().
+  /// finite entries. Preconditions: n >= 1, X.cols() == inputs.dimension().
   void Condition(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, const GpHyperparameters& h);
 
   /// Fits the hyperparameters by maximising the log marginal likelihood (with
@@ -77,14 +84,14 @@ class GaussianProcess {
   /// hyperparameters.
   double LogMarginalLikelihood() const { return log_marginal_likelihood_; }
   const GpHyperparameters& hyperparameters() const { return hyper_; }
-  int dimension() const { return static_cast<int>(periodic_.size()); }
-  const std::vector<bool>& periodic() const { return periodic_; }
+  int dimension() const { return inputs_.dimension(); }
+  const KernelInputs& inputs() const { return inputs_; }
   /// The standardisation applied to y: y_std = (y - output_mean()) / output_scale().
   double output_mean() const { return y_mean_; }
   double output_scale() const { return y_scale_; }
 
  private:
-  std::vector<bool> periodic_;
+  KernelInputs inputs_;
   GpHyperparameters hyper_;
   Eigen::MatrixXd X_;
   Eigen::MatrixXd scaled_features_;  // d' x n: embedded training inputs divided by length scales
@@ -101,7 +108,7 @@ class GaussianProcess {
 /// log_params. This is the objective GaussianProcess::Fit maximises (on the
 /// standardised outputs); it is exposed so the gradient can be checked.
 double GpLogMarginalLikelihood(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                               const std::vector<bool>& periodic, const Eigen::VectorXd& log_params,
+                               const KernelInputs& inputs, const Eigen::VectorXd& log_params,
                                Eigen::VectorXd* gradient);
 
 }  // namespace boicp

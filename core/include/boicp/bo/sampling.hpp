@@ -20,4 +20,10 @@ double UniformUnit(std::mt19937_64& rng);
 /// n independent uniform points in [0,1)^d (filled row by row); n x d.
 Eigen::MatrixXd UniformPoints(int n, int d, std::mt19937_64& rng);
 
+/// n rotations spread evenly over all rotations (a super-Fibonacci spiral on
+/// the unit quaternions, Alexa 2022), all turned by one rotation drawn
+/// uniformly from rng; as unit coordinates of their rotation vectors
+/// (UnitFromRotation), n x 3.
+Eigen::MatrixXd UniformRotations(int n, std::mt19937_64& rng);
+
 }  // namespace boicp

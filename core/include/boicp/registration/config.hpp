@@ -17,6 +17,11 @@ enum class SearchMode {
   kSixDof,  // all six degrees of freedom in one search
 };
 
+/// How a search box that holds every rotation names them (search_space.hpp).
+/// Euler angles are the paper's box; a rotation vector about the anchor has
+/// no gimbal lock, and its kernel measures the angle between two rotations.
+enum class RotationCoordinates { kEulerAngles, kRotationVector };
+
 SearchMode ParseSearchMode(const std::string& name);  // "nested" | "6dof"; throws InputError
 std::string SearchModeName(SearchMode mode);
 
@@ -103,6 +108,10 @@ struct BoIcpConfig {
   // rotation exactly once, so no rotation appears twice in the box.
   Eigen::Vector3d rotation_bounds{M_PI, M_PI / 2, M_PI};  // radians (roll, pitch, yaw)
   Eigen::Vector3d translation_bounds{4.0, 2.0, 1.0};      // metres (x, y, z), the paper's
+  // How a box holding every rotation names them; nullopt: rotation vectors on
+  // the ladder, the paper's Euler angles on the fixed budget. A narrower box
+  // (a LiDAR's level, any heading) is always in Euler angles.
+  std::optional<RotationCoordinates> rotation_coordinates;
 
   // --- ICP run by every evaluation ----------------------------------------
   IcpObjective icp_objective = IcpObjective::kPointToPlane;
@@ -172,6 +181,7 @@ struct BoIcpConfig {
   double EffectiveTruncation() const;
   double EffectiveRefineVoxel() const;
   double EffectiveInlierDistance() const;
+  RotationCoordinates EffectiveRotationCoordinates() const;
 };
 
 /// Preset "A" (10 random / 20 iterations / 0.7 m), "B" (20 / 35 / 0.7) or

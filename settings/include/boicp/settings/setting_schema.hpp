@@ -7,7 +7,7 @@
 // generated from this table, so a setting added here reaches every front end
 // at once. BoIcpConfig fields missing from the table (finish_icp_iterations,
 // refine_max_iterations, refine_candidates, refine_source_points,
-// inlier_distance, retry_voxel, bo) are engine tuning that no front end and
+// inlier_distance, retry_voxel, rotation_coordinates, bo) are engine tuning that no front end and
 // not the API takes.
 
 #include <cstdint>
