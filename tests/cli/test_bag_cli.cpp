@@ -1,7 +1,7 @@
 // `boicp map`, `info` and `submit` on bags: the same generated drive written
 // as a ROS 1 .bag, a ROS 2 .db3 folder and a ROS 2 .mcap file gives the same
-// trajectory as the folder of its scans; odometry becomes priors; bad bags
-// give one error line.
+// trajectory as the folder of its scans; odometry becomes priors, carried
+// to the sensor by /tf_static; bad bags give one error line.
 
 #include <unistd.h>
 
@@ -53,6 +53,7 @@ struct DriveMessage {
   int64_t stamp_ns = 0;
   Points points;                           // a scan
   Transform pose = Transform::Identity();  // an odometry pose
+  std::vector<FrameTransform> transforms;  // a /tf_static message
 };
 
 class BagCli : public ::testing::Test {
@@ -114,9 +115,12 @@ class BagCli : public ::testing::Test {
       std::snprintf(name, sizeof name, "scan%03d.pcd", i);
       std::ofstream(folder_ / name, std::ios::binary)
           << EncodeBinaryPcd(scans[static_cast<size_t>(i)]);
-      messages_.push_back({"/points", "sensor_msgs/PointCloud2", kFirstStamp + i * kScanPeriod,
+      messages_.push_back({"/points",
+                           "sensor_msgs/PointCloud2",
+                           kFirstStamp + i * kScanPeriod,
                            LoadPointCloud((folder_ / name).string()).points,
-                           Transform::Identity()});
+                           Transform::Identity(),
+                           {}});
     }
     for (int k = 0; k <= 2 * (n - 1); ++k) {
       const Transform& a = poses[static_cast<size_t>(k / 2)];
@@ -128,7 +132,7 @@ class BagCli : public ::testing::Test {
         pose.topLeftCorner<3, 3>() = qa.slerp(0.5, qb).toRotationMatrix();
       }
       messages_.push_back(
-          {"/odom", "nav_msgs/Odometry", kFirstStamp + k * kOdometryPeriod, {}, pose});
+          {"/odom", "nav_msgs/Odometry", kFirstStamp + k * kOdometryPeriod, {}, pose, {}});
     }
     std::stable_sort(
         messages_.begin(), messages_.end(),
@@ -140,6 +144,7 @@ class BagCli : public ::testing::Test {
     if (m.topic == "/points") {
       return test::EncodePointCloud2(m.points, m.stamp_ns, "velodyne", encoding, options);
     }
+    if (m.topic == "/tf_static") return test::EncodeTfMessage(m.transforms, m.stamp_ns, encoding);
     return test::EncodeOdometry(m.pose, m.stamp_ns, "odom", encoding);
   }
 
@@ -158,6 +163,9 @@ class BagCli : public ::testing::Test {
     test::BagTestContents contents;
     contents.topics = {{"/odom", "nav_msgs/msg/Odometry"},
                        {"/points", "sensor_msgs/msg/PointCloud2"}};
+    if (messages_.front().topic == "/tf_static") {
+      contents.topics.push_back({"/tf_static", "tf2_msgs/msg/TFMessage"});
+    }
     for (const DriveMessage& m : messages_) {
       contents.messages.push_back(
           {m.topic, m.stamp_ns + 2000000, Encode(m, MessageEncoding::kCdr, options)});
@@ -254,6 +262,53 @@ TEST_F(BagCli, OdometryGivesPriorsThatThePriorRungAnswers) {
   for (const json& pair : pairs) by_prior += pair["answered_by"] == "prior";
   EXPECT_GE(by_prior, 1) << pairs.dump(1);
   EXPECT_THAT(r.err, HasSubstr(std::to_string(by_prior) + " prior"));
+}
+
+// The odometry tracks base_link; the LiDAR sits on it a quarter turn round
+// and 1.2 m ahead, two /tf_static hops away. The priors are where the LiDAR
+// was, in either serialization.
+TEST_F(BagCli, TfStaticCarriesTheBodysOdometryToTheSensor) {
+  const Transform mount = PoseFromYawTranslation(0.3, {1.2, 0.0, 0.5});
+  const Transform lidar = PoseFromYawTranslation(M_PI / 2, {0.0, 0.1, 0.2});
+  const Transform base_velodyne = mount * lidar;
+  std::vector<Transform> sensor_poses;  // at the scans' stamps
+  for (DriveMessage& m : messages_) {
+    if (m.topic != "/odom") continue;
+    if ((m.stamp_ns - kFirstStamp) % kScanPeriod == 0) sensor_poses.push_back(m.pose);
+    m.pose = m.pose * base_velodyne.inverse();
+  }
+  BagScanSelection odometry;
+  odometry.odometry_topic = "/odom";
+  ScanFolderOptions options;
+  options.bag = odometry;
+  const auto read = [&](const fs::path& bag) { return ReadScanFolder(bag.string(), options); };
+
+  const fs::path body_only = dir_ / "body.mcap";
+  test::WriteMcap(body_only, Ros2Contents({}));
+  const ScanFolder untold = read(body_only);
+  EXPECT_THAT(untold.description, HasSubstr("no /tf_static path from base_link to velodyne"));
+  ASSERT_EQ(untold.reference_poses.size(), sensor_poses.size());
+  EXPECT_FALSE(untold.reference_poses[2]->isApprox(sensor_poses[2], 1e-3));
+
+  messages_.insert(messages_.begin(),
+                   DriveMessage{"/tf_static",
+                                "tf2_msgs/TFMessage",
+                                kFirstStamp,
+                                {},
+                                Transform::Identity(),
+                                {{"/base_link", "mount", mount}, {"mount", "velodyne", lidar}}});
+  const fs::path mcap = dir_ / "mounted.mcap";
+  test::WriteMcap(mcap, Ros2Contents({}));
+  for (const fs::path& bag : {mcap, WriteRos1Bag(test::Ros1BagCompression::kNone)}) {
+    SCOPED_TRACE(bag.filename().string());
+    const ScanFolder told = read(bag);
+    EXPECT_THAT(told.description, HasSubstr("velodyne on base_link from /tf_static"));
+    ASSERT_EQ(told.reference_poses.size(), sensor_poses.size());
+    for (size_t i = 0; i < sensor_poses.size(); ++i) {
+      ASSERT_TRUE(told.reference_poses[i]);
+      EXPECT_TRUE(told.reference_poses[i]->isApprox(sensor_poses[i], 1e-9)) << i;
+    }
+  }
 }
 
 TEST_F(BagCli, WindowEveryAndMinIntervalPickTheScans) {

@@ -200,4 +200,16 @@ std::vector<uint8_t> EncodePoseStamped(const Transform& pose, int64_t stamp_ns,
   return writer.Take();
 }
 
+std::vector<uint8_t> EncodeTfMessage(const std::vector<FrameTransform>& transforms,
+                                     int64_t stamp_ns, MessageEncoding encoding) {
+  MessageWriter writer(encoding, false);
+  writer.U32(static_cast<uint32_t>(transforms.size()));
+  for (const FrameTransform& t : transforms) {
+    writer.Header(stamp_ns, t.parent);
+    writer.String(t.child);
+    WritePose(writer, t.parent_child, std::nullopt);
+  }
+  return writer.Take();
+}
+
 }  // namespace boicp::test

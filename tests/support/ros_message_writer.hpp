@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "boicp/io/bag_reader.hpp"
+#include "boicp/io/ros_messages.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp::test {
@@ -47,5 +48,10 @@ std::vector<uint8_t> EncodeOdometry(const Transform& pose, int64_t stamp_ns,
 std::vector<uint8_t> EncodePoseStamped(const Transform& pose, int64_t stamp_ns,
                                        const std::string& frame_id, MessageEncoding encoding,
                                        const std::optional<Eigen::Vector4d>& quaternion_xyzw = {});
+
+/// A tf2_msgs/TFMessage holding one TransformStamped per entry of
+/// `transforms`.
+std::vector<uint8_t> EncodeTfMessage(const std::vector<FrameTransform>& transforms,
+                                     int64_t stamp_ns, MessageEncoding encoding);
 
 }  // namespace boicp::test

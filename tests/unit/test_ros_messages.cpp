@@ -1,4 +1,4 @@
-// Decoding PointCloud2, Odometry and PoseStamped from both serializations:
+// Decoding PointCloud2, Odometry, PoseStamped and TFMessage from both serializations:
 // exact round trips through the test encoders for every layout option, and
 // malformed messages (truncated, lying sizes, bad fields, bad quaternions)
 // refused with one InputError line naming the message.
@@ -97,6 +97,9 @@ TEST(RosMessages, TypeNamesInBothStyles) {
   }
   EXPECT_FALSE(IsPoseMessageType("geometry_msgs/Pose"));
   EXPECT_FALSE(IsPoseMessageType("sensor_msgs/PointCloud2"));
+  EXPECT_TRUE(IsTfMessageType("tf2_msgs/TFMessage"));
+  EXPECT_TRUE(IsTfMessageType("tf2_msgs/msg/TFMessage"));
+  EXPECT_FALSE(IsTfMessageType("geometry_msgs/TransformStamped"));
 }
 
 TEST(RosMessages, PointCloud2RoundTripsEveryLayout) {
@@ -269,6 +272,7 @@ TEST(RosMessages, PoseMessagesRoundTrip) {
       const StampedPose decoded = DecodePose(odometry, encoding, type);
       EXPECT_EQ(decoded.stamp_ns, kStamp);
       EXPECT_EQ(decoded.frame_id, "odom");
+      EXPECT_EQ(decoded.child_frame_id, "base_link");
       EXPECT_TRUE(decoded.pose.isApprox(pose, 1e-12)) << decoded.pose;
     }
     for (const char* type : {"geometry_msgs/PoseStamped", "geometry_msgs/msg/PoseStamped"}) {
@@ -319,6 +323,29 @@ TEST(RosMessages, PoseMessagesTruncatedAtEveryLengthAreRefused) {
       EXPECT_THAT(
           InputErrorMessage([&] { DecodePose(prefix, encoding, "geometry_msgs/PoseStamped"); }),
           HasSubstr("/odom#1: "))
+          << length;
+    }
+  }
+}
+
+TEST(RosMessages, TfMessagesRoundTripAndTruncatedOnesAreRefused) {
+  Transform mount = SamplePose();
+  const std::vector<FrameTransform> transforms = {{"base_link", "velodyne", mount},
+                                                  {"/base_link", "imu", Transform::Identity()}};
+  for (MessageEncoding encoding : {MessageEncoding::kRos1, MessageEncoding::kCdr}) {
+    const auto bytes = test::EncodeTfMessage(transforms, kStamp, encoding);
+    const std::vector<FrameTransform> decoded =
+        DecodeTfMessage(bytes.data(), bytes.size(), encoding, "/tf_static#1");
+    ASSERT_EQ(decoded.size(), 2u);
+    EXPECT_EQ(decoded[0].parent, "base_link");
+    EXPECT_EQ(decoded[0].child, "velodyne");
+    EXPECT_TRUE(decoded[0].parent_child.isApprox(mount, 1e-12));
+    EXPECT_EQ(decoded[1].parent, "/base_link");
+    EXPECT_TRUE(decoded[1].parent_child.isIdentity(1e-15));
+    for (size_t length = 0; length < bytes.size(); ++length) {
+      EXPECT_THAT(InputErrorMessage(
+                      [&] { DecodeTfMessage(bytes.data(), length, encoding, "/tf_static#1"); }),
+                  HasSubstr("/tf_static#1: "))
           << length;
     }
   }

@@ -6,9 +6,11 @@
 // hold that topic; otherwise (no summary, unchunked, or an index that does not
 // add up) the whole file is read record by record. Every declared length is
 // checked against the bytes present and against BagLimits before anything is
-// allocated from it. A chunk's records are checked against its CRC, where
-// the writer stored one; the data section's and the summary's CRCs are not
-// read (the first would cost a pass over the whole data section).
+// allocated from it. A chunk's records are checked against its CRC, and the
+// summary against the footer's, where the writer stored one (a summary that
+// fails its CRC is not used: the whole file is read instead). The data
+// section's CRC is not read: it would cost a pass over the whole data
+// section, and the chunks' own CRCs already cover their messages.
 
 #include <algorithm>
 #include <cstdint>

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "boicp/io/frame_tree.hpp"
 #include "io/io_readers.hpp"
 
 namespace boicp {
@@ -112,6 +113,50 @@ std::vector<StampedPose> ReadPoses(BagReader& bag, const BagTopic& topic) {
   return poses;
 }
 
+// Every transform of the bag's /tf_static topic, in log order; none when it
+// has no such topic.
+std::vector<FrameTransform> ReadStaticTransforms(BagReader& bag,
+                                                 const std::vector<BagTopic>& topics) {
+  std::vector<FrameTransform> transforms;
+  const BagTopic* topic = FindTopic(topics, "/tf_static");
+  if (topic == nullptr || !IsTfMessageType(topic->type)) return transforms;
+  for (const BagMessageRef& message : bag.Messages(topic->name)) {
+    const std::vector<uint8_t> data = bag.Read(message);
+    const std::vector<FrameTransform> some =
+        DecodeTfMessage(data.data(), data.size(), bag.encoding(),
+                        bag.path() + ": " + topic->name + " message at " +
+                            std::to_string(message.log_time_ns) + " ns");
+    transforms.insert(transforms.end(), some.begin(), some.end());
+  }
+  return transforms;
+}
+
+// Where the scans' sensor sits on the body frame the odometry tracks
+// (T_body_sensor), and what the user is told about it.
+struct Extrinsic {
+  Transform body_sensor = Transform::Identity();
+  std::string note;
+};
+
+Extrinsic FindExtrinsic(BagReader& bag, const std::vector<BagTopic>& topics,
+                        const std::string& body, const std::string& sensor) {
+  Extrinsic extrinsic;
+  if (body.empty() || sensor.empty()) {
+    extrinsic.note = "; its poses are taken as the sensor's (no body or sensor frame named)";
+    return extrinsic;
+  }
+  const std::optional<Transform> found =
+      TransformBetween(ReadStaticTransforms(bag, topics), body, sensor);
+  if (!found) {
+    extrinsic.note = "; no /tf_static path from " + body + " to " + sensor +
+                     ": its poses are taken as the sensor's";
+    return extrinsic;
+  }
+  extrinsic.body_sensor = *found;
+  if (!found->isIdentity()) extrinsic.note = "; " + sensor + " on " + body + " from /tf_static";
+  return extrinsic;
+}
+
 }  // namespace
 
 bool BagScanSelection::Any() const {
@@ -159,30 +204,38 @@ FullListing ListBagScans(const std::string& path, const BagScanSelection& select
   }
 
   FullListing out;
-  int with_prior = 0;
+  std::vector<int64_t> stamps;
+  std::string sensor_frame;
   for (const BagMessageRef& message : messages) {
     const std::vector<uint8_t> data = bag->Read(message);
     const std::string what =
         bag->path() + ": " + scan_topic.name + " message " + std::to_string(out.scans.size());
+    const PointCloud2Info info = PeekPointCloud2(data.data(), data.size(), bag->encoding(), what);
+    if (sensor_frame.empty()) sensor_frame = info.frame_id;
     // A driver that leaves the stamp at zero has only the log time to give.
-    int64_t stamp = PeekPointCloud2(data.data(), data.size(), bag->encoding(), what).stamp_ns;
-    if (stamp == 0) stamp = message.log_time_ns;
+    stamps.push_back(info.stamp_ns != 0 ? info.stamp_ns : message.log_time_ns);
     ScanSource scan;
     scan.path = bag->path();
     scan.load.format = CloudFormat::kRosMessage;
     scan.load.bag_message = message;
-    scan.timestamp = static_cast<double>(stamp) / kNanosecondsPerSecond;
+    scan.timestamp = static_cast<double>(stamps.back()) / kNanosecondsPerSecond;
     out.scans.push_back(std::move(scan));
-    if (!poses.empty()) {
-      out.reference_poses.push_back(InterpolatePose(poses, stamp));
-      with_prior += out.reference_poses.back().has_value();
-    }
   }
   out.what = BagStorageName(bag->storage()) + ", " + scan_topic.name;
-  if (!selection.odometry_topic.empty()) {
-    out.what += "; " + selection.odometry_topic + " gives priors to " + std::to_string(with_prior) +
-                " of them";
+  if (selection.odometry_topic.empty()) return out;
+  // The odometry tracks its body frame; a prior is where the sensor was.
+  const Extrinsic extrinsic =
+      poses.empty() ? Extrinsic{}
+                    : FindExtrinsic(*bag, topics, poses.front().child_frame_id, sensor_frame);
+  int with_prior = 0;
+  for (const int64_t stamp : poses.empty() ? std::vector<int64_t>{} : stamps) {
+    std::optional<Transform> pose = InterpolatePose(poses, stamp);
+    if (pose) pose = Transform(*pose * extrinsic.body_sensor);
+    with_prior += pose.has_value();
+    out.reference_poses.push_back(pose);
   }
+  out.what += "; " + selection.odometry_topic + " gives priors to " + std::to_string(with_prior) +
+              " of them" + extrinsic.note;
   return out;
 }
 

@@ -171,7 +171,8 @@ void DecodePoints(const CloudLayout& layout, DecodedPointCloud2& cloud) {
   }
 }
 
-// geometry_msgs/Pose: position, then orientation x, y, z, w.
+// geometry_msgs/Pose: position, then orientation x, y, z, w. A
+// geometry_msgs/Transform (translation, rotation) has the same layout.
 Transform ReadPose(MessageCursor& cursor) {
   Eigen::Vector3d t;
   t.x() = cursor.F64("pose.position.x");
@@ -198,7 +199,7 @@ Transform ReadPose(MessageCursor& cursor) {
 StampedPose ReadOdometry(MessageCursor& cursor) {
   StampedPose result;
   ReadHeader(cursor, result.stamp_ns, result.frame_id);
-  cursor.String("child_frame_id");
+  result.child_frame_id = cursor.String("child_frame_id");
   result.pose = ReadPose(cursor);
   cursor.SkipPrimitives(36, 8, "pose.covariance");
   cursor.SkipPrimitives(6, 8, "twist.twist");
@@ -221,6 +222,10 @@ bool IsPointCloud2Type(const std::string& type) {
 
 bool IsPoseMessageType(const std::string& type) {
   return IsOdometryType(type) || IsPoseStampedType(type);
+}
+
+bool IsTfMessageType(const std::string& type) {
+  return IsOneOf(type, "tf2_msgs/TFMessage", "tf2_msgs/msg/TFMessage");
 }
 
 PointCloud2Info PeekPointCloud2(const uint8_t* data, size_t size, MessageEncoding encoding,
@@ -255,6 +260,22 @@ StampedPose DecodePoseMessage(const uint8_t* data, size_t size, MessageEncoding 
   }
   MessageCursor cursor(data, size, encoding, what);
   return IsOdometryType(type) ? ReadOdometry(cursor) : ReadPoseStamped(cursor);
+}
+
+std::vector<FrameTransform> DecodeTfMessage(const uint8_t* data, size_t size,
+                                            MessageEncoding encoding, const std::string& what) {
+  MessageCursor cursor(data, size, encoding, what);
+  // A TransformStamped is at least a header, a child frame and 7 doubles.
+  constexpr size_t kMinTransformBytes = 7 * 8;
+  const uint32_t count = cursor.Count(kMinTransformBytes, "transforms");
+  std::vector<FrameTransform> transforms(count);
+  for (FrameTransform& transform : transforms) {
+    int64_t stamp_ns = 0;
+    ReadHeader(cursor, stamp_ns, transform.parent);
+    transform.child = cursor.String("child_frame_id");
+    transform.parent_child = ReadPose(cursor);
+  }
+  return transforms;
 }
 
 }  // namespace boicp

@@ -1,13 +1,15 @@
 #pragma once
 // Decoding the ROS messages a drive is logged as, from either serialization
 // (ROS 1 or CDR): sensor_msgs/PointCloud2 for scans, nav_msgs/Odometry and
-// geometry_msgs/PoseStamped for priors. Every size is checked against the
+// geometry_msgs/PoseStamped for priors, tf2_msgs/TFMessage for the static
+// transform from the odometry's body frame to the sensor's. Every size is checked against the
 // message's length before it is read; every failure throws boicp::InputError
 // "WHAT: problem", WHAT being the caller's name for the message.
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "boicp/io/bag_reader.hpp"
 #include "boicp/util/types.hpp"
@@ -18,6 +20,8 @@ namespace boicp {
 bool IsPointCloud2Type(const std::string& type);
 /// nav_msgs Odometry or geometry_msgs PoseStamped, in either naming style.
 bool IsPoseMessageType(const std::string& type);
+/// "tf2_msgs/TFMessage" or "tf2_msgs/msg/TFMessage".
+bool IsTfMessageType(const std::string& type);
 
 /// What a PointCloud2 declares, read without decoding its points.
 struct PointCloud2Info {
@@ -47,6 +51,7 @@ DecodedPointCloud2 DecodePointCloud2(const uint8_t* data, size_t size, MessageEn
 struct StampedPose {
   int64_t stamp_ns = 0;  // header.stamp
   std::string frame_id;
+  std::string child_frame_id;              // Odometry's body frame; empty for PoseStamped
   Transform pose = Transform::Identity();  // T_frame_child; for Odometry, pose.pose
 };
 
@@ -55,5 +60,17 @@ struct StampedPose {
 /// not finite or is far from unit length (|q| outside [0.9, 1.1]).
 StampedPose DecodePoseMessage(const uint8_t* data, size_t size, MessageEncoding encoding,
                               const std::string& type, const std::string& what);
+
+/// One transform of a TFMessage: where the child frame is in the parent's.
+struct FrameTransform {
+  std::string parent;                              // header.frame_id
+  std::string child;                               // child_frame_id
+  Transform parent_child = Transform::Identity();  // T_parent_child
+};
+
+/// Decodes a tf2_msgs/TFMessage (geometry_msgs/TransformStamped[]). Throws
+/// InputError as DecodePoseMessage does.
+std::vector<FrameTransform> DecodeTfMessage(const uint8_t* data, size_t size,
+                                            MessageEncoding encoding, const std::string& what);
 
 }  // namespace boicp
