@@ -145,8 +145,12 @@ Extrinsic FindExtrinsic(BagReader& bag, const std::vector<BagTopic>& topics,
     extrinsic.note = "; its poses are taken as the sensor's (no body or sensor frame named)";
     return extrinsic;
   }
-  const std::optional<Transform> found =
-      TransformBetween(ReadStaticTransforms(bag, topics), body, sensor);
+  std::optional<Transform> found;
+  try {
+    found = TransformBetween(ReadStaticTransforms(bag, topics), body, sensor);
+  } catch (const InputError& e) {
+    throw InputError(bag.path() + ": /tf_static: " + e.what());
+  }
   if (!found) {
     extrinsic.note = "; no /tf_static path from " + body + " to " + sensor +
                      ": its poses are taken as the sensor's";
@@ -223,16 +227,17 @@ FullListing ListBagScans(const std::string& path, const BagScanSelection& select
   }
   out.what = BagStorageName(bag->storage()) + ", " + scan_topic.name;
   if (selection.odometry_topic.empty()) return out;
-  // The odometry tracks its body frame; a prior is where the sensor was.
-  const Extrinsic extrinsic =
-      poses.empty() ? Extrinsic{}
-                    : FindExtrinsic(*bag, topics, poses.front().child_frame_id, sensor_frame);
   int with_prior = 0;
-  for (const int64_t stamp : poses.empty() ? std::vector<int64_t>{} : stamps) {
-    std::optional<Transform> pose = InterpolatePose(poses, stamp);
-    if (pose) pose = Transform(*pose * extrinsic.body_sensor);
-    with_prior += pose.has_value();
-    out.reference_poses.push_back(pose);
+  Extrinsic extrinsic;
+  if (!poses.empty()) {
+    // The odometry tracks its body frame; a prior is where the sensor was.
+    extrinsic = FindExtrinsic(*bag, topics, poses.front().child_frame_id, sensor_frame);
+    for (const int64_t stamp : stamps) {
+      std::optional<Transform> pose = InterpolatePose(poses, stamp);
+      if (pose) pose = Transform(*pose * extrinsic.body_sensor);
+      with_prior += pose.has_value();
+      out.reference_poses.push_back(pose);
+    }
   }
   out.what += "; " + selection.odometry_topic + " gives priors to " + std::to_string(with_prior) +
               " of them" + extrinsic.note;
