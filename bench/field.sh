@@ -3,8 +3,10 @@
 # condition (bench/field_conditions.hpp), automatic settings, then the
 # report of success and flagged misses per condition (bench/field_report.py).
 #
-#   bench/field.sh OUT [--methods M[,M...]] [--data-root DIR] [--threads T]
+#   bench/field.sh OUT [--methods M[,M...]] [--data-root DIR] [--threads T] [--seed S]
 #
+# The seed draws each pair's start and each condition's cut, shift and
+# subsample; another seed is another sample of the same suite.
 # Writes OUT/<condition>/ (a boicp-bench run each, with attempts.csv for
 # bench/fit_confidence.py --folds) and OUT/<condition>.log.
 # Uses build/bin/boicp-bench (BIN overrides).
@@ -13,7 +15,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${BIN:-$ROOT/build/bin/boicp-bench}"
 # Open3D's OpenMP threads sleep while they wait, as in bench/run.sh.
 export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}"
-[ $# -ge 1 ] || { sed -n '2,10p' "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n '2,13p' "$0"; exit 2; }
 OUT="$1"; shift
 METHODS="bo-C-auto,bo-C"
 DATA_ROOT="$ROOT/../shared/data"
@@ -24,6 +26,7 @@ while [ $# -gt 0 ]; do
     --methods) METHODS="$2"; shift ;;
     --data-root) DATA_ROOT="$2"; shift ;;
     --threads) THREADS="$2"; shift ;;
+    --seed) SEED="$2"; shift ;;
     *) echo "field.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
   shift

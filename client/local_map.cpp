@@ -151,8 +151,9 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
   PairFileStore store(batch.scans, batch.config, out_dir);
   TerminalProgress progress;
   ThreadPool pool(threads);
-  const RegisteredPairs registered = RegisterPlannedPairs(
-      batch.scans, batch.config, PlanFixedPairs(pairs), store, progress, LocalExecution(pool));
+  const RegisteredPairs registered =
+      RegisterPlannedPairs(batch.scans, batch.config, batch.scale, PlanFixedPairs(pairs), store,
+                           progress, LocalExecution(pool));
   progress.FinishPairs();
   return registered.reused;
 }

@@ -182,7 +182,7 @@ MapSettings WithAbsolutePaths(MapSettings settings) {
 void ChooseMapRunSettings(LocalRun& run, int threads, uint64_t max_fusion_mb) {
   MapBatch& batch = run.batch;
   const std::vector<RangeProfile> profiles = ProfileScans(batch.scans, threads);
-  run.chosen = ChooseBatchSettings(batch);
+  run.chosen = ChooseBatchSettings(batch, profiles);
   RequireVoxelsFitExtent(batch.config, ProfilesExtent(profiles));
   batch.map.max_fusion_bytes = static_cast<size_t>(max_fusion_mb << 20);
   RequireFusionWithinLimit(batch.scans, profiles, batch.map.occupancy, batch.map.max_fusion_bytes);
@@ -215,6 +215,14 @@ void PrintRunSettings(const LocalRun& run) {
                  "settings: %zu points of %zu of the %zu measured scans set aside as far returns "
                  "(they stay in the scans; run.json lists them)\n",
                  far_returns, scans_with_far_returns, run.chosen.measured.size());
+  }
+  const BatchScale& scale = run.batch.scale;
+  if (const size_t rescaled = CountScansAtAnotherScale(scale); rescaled > 0) {
+    std::fprintf(stderr,
+                 "settings: %zu of %zu scans reach over %g times nearer or farther than the "
+                 "measured ones (median range %.3g m); their pairs search at settings scaled to "
+                 "fit\n",
+                 rescaled, run.batch.scans.size(), kSameScaleFactor, scale.reference_range);
   }
 }
 

@@ -91,7 +91,8 @@ class JobRun : public MapProgressSink {
     }
     VerifyScans();
     // Chosen once from the job's scans; a resumed job chooses the same again.
-    const BatchSettingsChoice choice = ChooseBatchSettings(spec_.batch);
+    const std::vector<RangeProfile> profiles = ScanProfiles();
+    const BatchSettingsChoice choice = ChooseBatchSettings(spec_.batch, profiles);
     *job_.mutable_settings() = ChosenSettingsToProto(spec_.batch.config, spec_.batch.map, choice);
     job_.mutable_settings()->set_scan_format(
         rpc::ScanFormatOf(spec_.batch.scans.at(0).load.format));
@@ -99,7 +100,7 @@ class JobRun : public MapProgressSink {
     // thread per worker (the map does not depend on the count).
     spec_.batch.map.fusion_threads = ctx_.pool.size();
     spec_.batch.map.max_fusion_bytes = ctx_.max_fusion_bytes;
-    RequireFusionWithinLimit(spec_.batch.scans, ScanProfiles(), spec_.batch.map.occupancy,
+    RequireFusionWithinLimit(spec_.batch.scans, profiles, spec_.batch.map.occupancy,
                              ctx_.max_fusion_bytes);
     job_.set_state(v1::JOB_STATE_RUNNING);
     if (job_.started_at() == 0.0) job_.set_started_at(rpc::NowSeconds());
@@ -140,6 +141,14 @@ class JobRun : public MapProgressSink {
     spdlog::info("job {} running: {} scans, {} pairing, preset {}, {} of {} pairs already done",
                  job_.job_id(), spec_.batch.scans.size(), PairingModeName(spec_.batch.pairing.mode),
                  spec_.batch.config.preset, counts.done, counts.total);
+    const BatchScale& scale = spec_.batch.scale;
+    if (const size_t rescaled = CountScansAtAnotherScale(scale); rescaled > 0) {
+      spdlog::info(
+          "job {}: {} of {} scans reach over {} times nearer or farther than the "
+          "measured ones ({:.3g} m); their pairs search at settings scaled to fit",
+          job_.job_id(), rescaled, spec_.batch.scans.size(), kSameScaleFactor,
+          scale.reference_range);
+    }
   }
 
   void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {

@@ -47,6 +47,7 @@ using boicp::test::RunResult;
 using boicp::test::Slurp;
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 namespace fs = std::filesystem;
 using nlohmann::json;
 
@@ -385,6 +386,24 @@ TEST_F(MapCli, FarReturnsAreListedInRunJson) {
     const Transform expected = truth_[0].inverse() * truth_[i];
     EXPECT_NEAR(TranslationNorm(expected.inverse() * poses[i]), 0.0, 0.1) << "scan " << i;
   }
+}
+
+// The drive's last two scans shrunk to 1/8, as if it went indoors: the
+// settings come from five scans, mostly full size, and `map` says that the
+// small scans' pairs search at settings scaled to fit them.
+TEST_F(MapCli, ScansAtAnotherScaleAreCounted) {
+  const fs::path scans = MakeDrive(6);
+  const RunResult same = Run("map " + scans.string() + " -o " + (dir_ / "same").string() + Quick());
+  ASSERT_EQ(same.exit_code, 0) << same.err;
+  EXPECT_THAT(same.err, Not(HasSubstr("nearer or farther")));
+  for (const char* name : {"scan004.xyz", "scan005.xyz"}) {
+    Points scan = LoadPointCloud((scans / name).string()).points;
+    for (Point& p : scan) p /= 8.0;
+    WriteXyz((scans / name).string(), scan);
+  }
+  const RunResult r = Run("map " + scans.string() + " -o " + (dir_ / "out").string() + Quick());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("settings: 2 of 6 scans reach over 2 times nearer or farther"));
 }
 
 TEST_F(MapCli, BadInputGivesOneLineErrorExitCode2AndNoMap) {

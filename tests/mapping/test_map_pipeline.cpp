@@ -95,8 +95,8 @@ TEST(MapPipeline, StoredPairsAreReusedAndNothingIsRegisteredAgain) {
   MemoryStore store({Finished(1, 2, 0.9), Finished(0, 1, 0.9), Finished(7, 8, 0.9)});
   RecordingProgress progress;
   const RegisteredPairs registered =
-      RegisterPlannedPairs(MissingScans(3), FinalConfig(), PlanFixedPairs(ConsecutivePairs(3)),
-                           store, progress, OnPool(pool));
+      RegisterPlannedPairs(MissingScans(3), FinalConfig(), BatchScale{},
+                           PlanFixedPairs(ConsecutivePairs(3)), store, progress, OnPool(pool));
   EXPECT_TRUE(store.saved_.empty());
   // In plan order; a stored pair the plan does not hold is ignored.
   EXPECT_THAT(progress.finished, ElementsAre(PairIndex{0, 1}, PairIndex{1, 2}));
@@ -112,8 +112,9 @@ TEST(MapPipeline, KeyframeChainComesFromTheStoredOverlaps) {
   MemoryStore store({Finished(1, 0, 0.9), Finished(2, 0, 0.8), Finished(3, 0, 0.2),
                      Finished(3, 2, 0.9), Finished(0, 1, 0.9)});
   RecordingProgress progress;
-  const RegisteredPairs registered = RegisterPlannedPairs(
-      MissingScans(4), FinalConfig(), PlanKeyframes(0.7), store, progress, OnPool(pool));
+  const RegisteredPairs registered =
+      RegisterPlannedPairs(MissingScans(4), FinalConfig(), BatchScale{}, PlanKeyframes(0.7), store,
+                           progress, OnPool(pool));
   EXPECT_TRUE(store.saved_.empty());
   EXPECT_THAT(registered.chain, ElementsAre(PairIndex{1, 0}, PairIndex{2, 0}, PairIndex{3, 2}));
   // The probe 3 -> 0 is kept (listed), the consecutive-direction 0 -> 1 is not the plan's.
@@ -126,8 +127,8 @@ TEST(MapPipeline, AFailedPairIsReportedAndRethrownAfterTheOthersStop) {
   MemoryStore store({});
   RecordingProgress progress;
   EXPECT_THROW(
-      RegisterPlannedPairs(MissingScans(4), FinalConfig(), PlanFixedPairs(ConsecutivePairs(4)),
-                           store, progress, OnPool(pool)),
+      RegisterPlannedPairs(MissingScans(4), FinalConfig(), BatchScale{},
+                           PlanFixedPairs(ConsecutivePairs(4)), store, progress, OnPool(pool)),
       InputError);
   ASSERT_EQ(progress.failed.size(), 1u);
   EXPECT_THAT(progress.failure, HasSubstr("scan"));
@@ -138,10 +139,10 @@ TEST(MapPipeline, AStopRequestEndsRegistrationWithCancelled) {
   ThreadPool pool(1);
   MemoryStore store({});
   RecordingProgress progress;
-  EXPECT_THROW(
-      RegisterPlannedPairs(MissingScans(4), FinalConfig(), PlanFixedPairs(ConsecutivePairs(4)),
-                           store, progress, OnPool(pool, [] { return true; })),
-      Cancelled);
+  EXPECT_THROW(RegisterPlannedPairs(MissingScans(4), FinalConfig(), BatchScale{},
+                                    PlanFixedPairs(ConsecutivePairs(4)), store, progress,
+                                    OnPool(pool, [] { return true; })),
+               Cancelled);
   EXPECT_TRUE(progress.failed.empty());
 }
 

@@ -9,6 +9,7 @@
 
 #include "../support/demo_sequence.hpp"
 #include "../support/files_and_processes.hpp"
+#include "boicp/mapping/fusion_memory.hpp"
 #include "boicp/settings/map_batch_request.hpp"
 
 namespace boicp::settings {
@@ -108,7 +109,7 @@ TEST(ChooseBatchSettings, ChoosesWhatApplyBatchSettingsChoosesAndLeavesNothingAu
   const BatchSettingsChoice applied = ApplyBatchSettings(expected.scans, expected.config,
                                                          expected.map.occupancy, expected.map_auto);
 
-  const BatchSettingsChoice chosen = ChooseBatchSettings(batch);
+  const BatchSettingsChoice chosen = ChooseBatchSettings(batch, ProfileScans(batch.scans, 1));
   EXPECT_EQ(chosen.fields, applied.fields);
   EXPECT_EQ(chosen.sensor, applied.sensor);
   EXPECT_EQ(batch.config.voxel, expected.config.voxel);
@@ -118,6 +119,10 @@ TEST(ChooseBatchSettings, ChoosesWhatApplyBatchSettingsChoosesAndLeavesNothingAu
   EXPECT_TRUE(batch.config.automatic.empty());
   EXPECT_FALSE(batch.map_auto.resolution);
   EXPECT_FALSE(batch.map_auto.max_range);
+  // One drive at one scale: every pair keeps the batch's settings.
+  EXPECT_GT(batch.scale.reference_range, 0.0);
+  EXPECT_EQ(batch.scale.scan_ranges.size(), scans.size());
+  EXPECT_EQ(PairScaleStep(batch.scale, {4, 0}), 0);
 }
 
 }  // namespace

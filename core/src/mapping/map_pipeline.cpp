@@ -69,8 +69,8 @@ MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapPro
                                  const PairExecution& execution, const MapOutputPaths& outputs,
                                  const MapPipelineHooks& hooks) {
   MapPipelineResult result;
-  result.pairs =
-      RegisterPlannedPairs(batch.scans, batch.config, batch.plan, store, progress, execution);
+  result.pairs = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, batch.plan, store,
+                                      progress, execution);
   result.map =
       AssembleMap(batch, result.pairs, store, progress, outputs, execution.stop_requested, hooks);
   return result;

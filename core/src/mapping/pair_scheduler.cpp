@@ -13,6 +13,8 @@
 #include <string>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/pair_scale.hpp"
+#include "boicp/mapping/prepared_scan_cache.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -51,21 +53,59 @@ bool PlanUses(const PairingPlan& plan, const PairIndex& pair) {
   return plan.keyframes ? pair.source > pair.target : listed(plan.chain);
 }
 
+// The batch's settings at each scale step its pairs use, with each scan
+// prepared at them: the pairs of one step share their scans' preparation.
+class ScaledPreparation {
+ public:
+  struct Level {
+    BoIcpConfig config;
+    std::unique_ptr<const RegistrationMethod> method;  // prepares every scan of this step
+    std::unique_ptr<PreparedScanCache> prepared;
+  };
+
+  ScaledPreparation(const std::vector<ScanSource>& scans, const BoIcpConfig& config,
+                    const BatchScale& scale, size_t capacity)
+      : scans_(scans), config_(config), scale_(scale), capacity_(capacity) {}
+
+  // The level of `pair`'s step, built on first use; it lives as long as this.
+  // Thread-safe.
+  Level& For(const PairIndex& pair) {
+    const int step = PairScaleStep(scale_, pair);
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::unique_ptr<Level>& level = levels_[step];
+    if (!level) {
+      auto built = std::make_unique<Level>();
+      built->config = ScaledConfig(config_, scale_, step);
+      built->method = CoreMethods().Create(built->config.method, built->config);
+      built->prepared = std::make_unique<PreparedScanCache>(scans_, *built->method, capacity_);
+      level = std::move(built);
+    }
+    return *level;
+  }
+
+ private:
+  const std::vector<ScanSource>& scans_;
+  const BoIcpConfig& config_;
+  const BatchScale& scale_;
+  const size_t capacity_;
+  std::mutex mutex_;
+  std::map<int, std::unique_ptr<Level>> levels_;  // by step; guarded by mutex_
+};
+
 class PairScheduler {
  public:
   PairScheduler(const std::vector<ScanSource>& scans, const BoIcpConfig& config,
-                const PairingPlan& plan, PairStore& store, MapProgressSink& progress,
-                const PairExecution& execution)
+                const BatchScale& scale, const PairingPlan& plan, PairStore& store,
+                MapProgressSink& progress, const PairExecution& execution)
       : scans_(scans),
-        config_(config),
         plan_(plan),
         store_(store),
         progress_(progress),
         execution_(execution),
         num_scans_(static_cast<int>(scans.size())),
-        method_(CoreMethods().Create(config.method, config)),
         // Pairs in flight share scans with the next pairs out of the queue.
-        prepared_(scans, *method_, static_cast<size_t>(std::max(execution.max_in_flight, 1)) + 2) {}
+        preparation_(scans, config, scale,
+                     static_cast<size_t>(std::max(execution.max_in_flight, 1)) + 2) {}
 
   RegisteredPairs Run() {
     LoadStored();
@@ -247,7 +287,8 @@ class PairScheduler {
       completion.stopped = true;
     } else {
       try {
-        PairResult result = RegisterBatchPair(scans_, pair, config_, prepared_, stop);
+        ScaledPreparation::Level& level = preparation_.For(pair);
+        PairResult result = RegisterBatchPair(scans_, pair, level.config, *level.prepared, stop);
         store_.Save(order, result);
         completion.finished = std::move(result);
       } catch (const Cancelled&) {
@@ -284,14 +325,12 @@ class PairScheduler {
   }
 
   const std::vector<ScanSource>& scans_;
-  const BoIcpConfig& config_;
   const PairingPlan& plan_;
   PairStore& store_;
   MapProgressSink& progress_;
   const PairExecution& execution_;
   const int num_scans_;
-  const std::unique_ptr<const RegistrationMethod> method_;  // prepares every scan
-  PreparedScanCache prepared_;                              // shared by the pair tasks
+  ScaledPreparation preparation_;  // shared by the pair tasks
 
   // Used on the scheduling thread only.
   std::map<PairIndex, PairResult> finished_;
@@ -316,10 +355,10 @@ class PairScheduler {
 }  // namespace
 
 RegisteredPairs RegisterPlannedPairs(const std::vector<ScanSource>& scans,
-                                     const BoIcpConfig& config, const PairingPlan& plan,
-                                     PairStore& store, MapProgressSink& progress,
-                                     const PairExecution& execution) {
-  PairScheduler scheduler(scans, config, plan, store, progress, execution);
+                                     const BoIcpConfig& config, const BatchScale& scale,
+                                     const PairingPlan& plan, PairStore& store,
+                                     MapProgressSink& progress, const PairExecution& execution) {
+  PairScheduler scheduler(scans, config, scale, plan, store, progress, execution);
   return scheduler.Run();
 }
 

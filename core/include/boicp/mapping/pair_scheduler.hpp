@@ -12,6 +12,7 @@
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/mapping/map_progress.hpp"
+#include "boicp/mapping/pair_scale.hpp"
 #include "boicp/mapping/pair_store.hpp"
 #include "boicp/registration/config.hpp"
 
@@ -37,10 +38,11 @@ struct RegisteredPairs {
 };
 
 /// Loads the store's finished pairs, then registers the rest of `plan` with
-/// RegisterBatchPair on `execution`, saving each result in `store` before it
-/// reports it to `progress`. Keyframe probes are handed out one at a time as
-/// slots free up; the plan's decisions depend only on the recorded overlaps
-/// (KeyframePlanner), so the chain does not depend on the thread count.
+/// RegisterBatchPair on `execution`, each pair with `config` scaled by its
+/// PairScaleStep in `scale` (a default BatchScale scales nothing), saving each result in `store`
+/// before it reports it to `progress`. Keyframe probes are handed out one at a time as slots free
+/// up; the plan's decisions depend only on the recorded overlaps (KeyframePlanner), so the chain
+/// does not depend on the thread count.
 ///
 /// Returns only once no task it launched is running. Throws Cancelled when
 /// stop_requested fires, and otherwise the first pair's failure (after
@@ -48,8 +50,8 @@ struct RegisteredPairs {
 /// Preconditions: `config` is the batch's final config (ApplyBatchSettings
 /// done); every index of `plan` is within `scans`.
 RegisteredPairs RegisterPlannedPairs(const std::vector<ScanSource>& scans,
-                                     const BoIcpConfig& config, const PairingPlan& plan,
-                                     PairStore& store, MapProgressSink& progress,
-                                     const PairExecution& execution);
+                                     const BoIcpConfig& config, const BatchScale& scale,
+                                     const PairingPlan& plan, PairStore& store,
+                                     MapProgressSink& progress, const PairExecution& execution);
 
 }  // namespace boicp
