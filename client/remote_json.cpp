@@ -1,6 +1,10 @@
 #include "remote_json.hpp"
 
 #include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include <google/protobuf/util/json_util.h>
 
 #include "boicp/rpc/pair_result_proto.hpp"
 #include "boicp/rpc/settings_proto.hpp"
@@ -51,25 +55,20 @@ std::string DescribeChosenSettings(const v1::ChosenSettings& s) {
 }
 
 nlohmann::json JobToJson(const v1::Job& job) {
-  return {
-      {"job_id", job.job_id()},
-      {"label", job.label()},
-      {"state", rpc::JobStateName(job.state())},
-      {"stage", job.stage()},
-      {"pairs_done", job.pairs_done()},
-      {"pairs_total", job.pairs_total()},
-      {"pairs_doubtful", job.pairs_doubtful()},
-      {"num_scans", job.num_scans()},
-      {"stage_done", job.stage_done()},
-      {"stage_total", job.stage_total()},
-      {"eta_seconds", job.eta_seconds()},
-      {"created_at", job.created_at()},
-      {"started_at", job.started_at()},
-      {"finished_at", job.finished_at()},
-      {"error", job.error()},
-      {"cancel_requested", job.cancel_requested()},
-      {"pose_graph_optimised", job.pose_graph_optimised()},
-      {"settings", job.has_settings() ? ChosenSettingsToJson(job.settings()) : nlohmann::json()}};
+  // Every field under its .proto name, defaults included, so that a field
+  // the daemon gains reaches scripts without a change here; the state by its
+  // short name, and the settings as `register --json` prints them.
+  google::protobuf::util::JsonPrintOptions options;
+  options.preserve_proto_field_names = true;
+  options.always_print_primitive_fields = true;
+  std::string text;
+  const auto status = google::protobuf::util::MessageToJsonString(job, &text, options);
+  if (!status.ok()) throw std::runtime_error("job " + job.job_id() + ": " + status.ToString());
+  nlohmann::json out = nlohmann::json::parse(text);
+  out["state"] = rpc::JobStateName(job.state());
+  out.erase("stage_code");  // "stage" names it
+  out["settings"] = job.has_settings() ? ChosenSettingsToJson(job.settings()) : nlohmann::json();
+  return out;
 }
 
 nlohmann::json PairToJson(const v1::PairResult& pair) {

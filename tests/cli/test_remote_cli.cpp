@@ -29,6 +29,7 @@
 
 #include "../support/demo_sequence.hpp"
 #include "../support/files_and_processes.hpp"
+#include "boicp/v1/map_builder.pb.h"
 #include "daemon_process.hpp"
 
 namespace {
@@ -186,6 +187,17 @@ TEST_F(RemoteCli, GeneratedDriveSubmitWaitShowJobsAndExport) {
   EXPECT_EQ(j["job_id"], job);
   EXPECT_EQ(j["state"], "succeeded");
   EXPECT_EQ(j["label"], "drive4");
+  // Every field of the job under its .proto name, the defaults too; the
+  // stage by its name only.
+  const google::protobuf::Descriptor& job_fields = *boicp::v1::Job::descriptor();
+  for (int f = 0; f < job_fields.field_count(); ++f) {
+    const std::string name = job_fields.field(f)->name();
+    EXPECT_EQ(j.contains(name), name != "stage_code") << name;
+  }
+  EXPECT_EQ(j["stage"], "done");
+  EXPECT_EQ(j["pairs_done"], 3);
+  EXPECT_EQ(j["error"], "");
+  EXPECT_EQ(j["cancel_requested"], false);
   // The settings used, under the names run.json's "chosen" has.
   const nlohmann::json& used = j["settings"];
   EXPECT_EQ(used["preset"], "A");
