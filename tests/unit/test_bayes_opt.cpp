@@ -49,7 +49,7 @@ double Hartmann3(const Eigen::VectorXd& x) {
 }
 constexpr double kHartmann3Minimum = -3.86278;
 
-BayesOptOptions Budget(int initial, int iterations) {
+BayesOptOptions SearchBudget(int initial, int iterations) {
   BayesOptOptions o;
   o.initial_samples = initial;
   o.iterations = iterations;
@@ -104,7 +104,7 @@ TEST(BayesOptTest, FindsBraninMinimum) {
   // Branin's outputs span 0.4 .. 300 (std ~ 50), so the default margin of 0.01
   // output std (~0.5) is ten times the tolerance and EI would stop refining
   // short of it; a margin of 0.001 std (~0.05) matches the tolerance.
-  BayesOptOptions options = Budget(10, 30);
+  BayesOptOptions options = SearchBudget(10, 30);
   options.acquisition.xi = 0.001;
   const int successes = CountSuccesses("Branin", BraninUnit, 2, kBraninMinimum, 0.05, options);
   EXPECT_GE(successes, 9);
@@ -114,12 +114,12 @@ TEST(BayesOptTest, FindsHartmann3Minimum) {
   // Budget: 10 Latin-hypercube samples + 40 EI steps, default options;
   // success = within 0.1.
   const int successes =
-      CountSuccesses("Hartmann3", Hartmann3, 3, kHartmann3Minimum, 0.1, Budget(10, 40));
+      CountSuccesses("Hartmann3", Hartmann3, 3, kHartmann3Minimum, 0.1, SearchBudget(10, 40));
   EXPECT_GE(successes, 9);
 }
 
 TEST(BayesOptTest, SameSeedGivesIdenticalHistory) {
-  BayesOptOptions options = Budget(5, 8);
+  BayesOptOptions options = SearchBudget(5, 8);
   options.refit_every = 3;
   const std::vector<bool> periodic = {false, true};
   const BayesOptResult a = MinimiseBayesOpt(BraninUnit, periodic, options, 77);
@@ -142,7 +142,7 @@ TEST(BayesOptTest, SameSeedGivesIdenticalHistory) {
 class BayesOptBatches : public ::testing::TestWithParam<int> {};
 
 TEST_P(BayesOptBatches, ParallelRoundsEqualTheirSerialTwin) {
-  BayesOptOptions options = Budget(5, 9);
+  BayesOptOptions options = SearchBudget(5, 9);
   options.batch_size = GetParam();
   const BayesOptResult serial = MinimiseBayesOpt(BraninUnit, {false, false}, options, 11);
   options.threads = 2;
@@ -158,7 +158,7 @@ TEST_P(BayesOptBatches, ParallelRoundsEqualTheirSerialTwin) {
 
 TEST_P(BayesOptBatches, ProposalsOfARoundAreDistinctAndToldThePreviousRoundsBest) {
   const int q = GetParam();
-  BayesOptOptions options = Budget(4, 8);
+  BayesOptOptions options = SearchBudget(4, 8);
   options.batch_size = q;
   std::vector<double> incumbents;
   std::vector<double> values;
@@ -195,7 +195,7 @@ TEST(BayesOptTest, ReportsProgressAndKeepsInitialPointsFirst) {
     last_best = best_y;
   };
   const BayesOptResult r =
-      MinimiseBayesOpt(BraninUnit, {false, false}, Budget(4, 5), 3, initial, progress);
+      MinimiseBayesOpt(BraninUnit, {false, false}, SearchBudget(4, 5), 3, initial, progress);
   ASSERT_EQ(r.history.size(), 9u);
   EXPECT_TRUE(r.history[0].x == Eigen::Vector2d(0.25, 1.0));  // clamped into the box
   EXPECT_TRUE(r.history[1].x == Eigen::Vector2d(0.5, 0.5));
@@ -215,7 +215,7 @@ TEST(BayesOptTest, InitialPointsBeyondTheBudgetAreAllUsed) {
   const std::vector<Eigen::VectorXd> initial(3, Eigen::VectorXd::Constant(1, 0.3));
   const BayesOptResult r =
       MinimiseBayesOpt([](const Eigen::VectorXd& x) { return (x(0) - 0.7) * (x(0) - 0.7); }, {true},
-                       Budget(2, 1), 1, initial);
+                       SearchBudget(2, 1), 1, initial);
   EXPECT_EQ(r.history.size(), 4u);
 }
 
@@ -227,7 +227,7 @@ TEST(BayesOptTest, StopRequestThrowsCancelledBeforeTheNextEvaluation) {
     return BraninUnit(x);
   };
   const std::function<bool()> stop = [&] { return ++polls > 7; };
-  BayesOptOptions one_at_a_time = Budget(5, 10);
+  BayesOptOptions one_at_a_time = SearchBudget(5, 10);
   one_at_a_time.batch_size = 1;
   EXPECT_THROW(MinimiseBayesOpt(f, {false, false}, one_at_a_time, 1, {}, {}, stop), Cancelled);
   EXPECT_EQ(evaluations, 7);
@@ -236,14 +236,15 @@ TEST(BayesOptTest, StopRequestThrowsCancelledBeforeTheNextEvaluation) {
   // 3 rounds, so 7 polls allow 3 + 4 rounds = 13 evaluations.
   evaluations = 0;
   polls = 0;
-  EXPECT_THROW(MinimiseBayesOpt(f, {false, false}, Budget(5, 10), 1, {}, {}, stop), Cancelled);
+  EXPECT_THROW(MinimiseBayesOpt(f, {false, false}, SearchBudget(5, 10), 1, {}, {}, stop),
+               Cancelled);
   EXPECT_EQ(evaluations, 13);
 }
 
 // A search ended early by `enough` and then resumed spends the whole budget
 // once: the resumed run repeats none of the evaluations it was handed.
 TEST(BayesOptTest, AnEarlyEndIsResumedToTheWholeBudgetWithoutRepeats) {
-  const BayesOptOptions options = Budget(6, 10);
+  const BayesOptOptions options = SearchBudget(6, 10);
   const std::vector<bool> periodic = {false, false};
   int calls = 0;
   const BoundedObjective f = [&](const Eigen::VectorXd& x, double) {
@@ -274,24 +275,24 @@ TEST(BayesOptTest, AnEarlyEndIsResumedToTheWholeBudgetWithoutRepeats) {
 TEST(BayesOptTest, InvalidOptionsThrowInputError) {
   const UnitObjective f = [](const Eigen::VectorXd& x) { return x.squaredNorm(); };
   const std::vector<bool> two = {false, false};
-  BayesOptOptions o = Budget(0, 3);
+  BayesOptOptions o = SearchBudget(0, 3);
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
-  o = Budget(3, -1);
+  o = SearchBudget(3, -1);
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
-  o = Budget(3, 3);
+  o = SearchBudget(3, 3);
   o.refit_every = 0;
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
-  o = Budget(3, 3);
+  o = SearchBudget(3, 3);
   o.batch_size = 0;
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
-  o = Budget(3, 3);
+  o = SearchBudget(3, 3);
   o.threads = 0;
   EXPECT_THROW(MinimiseBayesOpt(f, two, o, 1), InputError);
-  EXPECT_THROW(MinimiseBayesOpt(f, {}, Budget(3, 3), 1), InputError);
-  EXPECT_THROW(MinimiseBayesOpt(f, two, Budget(3, 3), 1, {Eigen::Vector3d(0.1, 0.2, 0.3)}),
+  EXPECT_THROW(MinimiseBayesOpt(f, {}, SearchBudget(3, 3), 1), InputError);
+  EXPECT_THROW(MinimiseBayesOpt(f, two, SearchBudget(3, 3), 1, {Eigen::Vector3d(0.1, 0.2, 0.3)}),
                InputError);
   try {
-    MinimiseBayesOpt(f, two, Budget(0, 3), 1);
+    MinimiseBayesOpt(f, two, SearchBudget(0, 3), 1);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("initial_samples"), std::string::npos) << e.what();
@@ -304,7 +305,7 @@ TEST(BayesOptTest, NonFiniteObjectiveNamesTheEvaluation) {
     return ++calls == 4 ? std::numeric_limits<double>::quiet_NaN() : 1.0;
   };
   try {
-    MinimiseBayesOpt(f, {false}, Budget(5, 2), 1);
+    MinimiseBayesOpt(f, {false}, SearchBudget(5, 2), 1);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("evaluation 3"), std::string::npos) << e.what();
