@@ -216,13 +216,9 @@ void PrintRunSettings(const LocalRun& run) {
                  "(they stay in the scans; run.json lists them)\n",
                  far_returns, scans_with_far_returns, run.chosen.measured.size());
   }
-  const BatchScale& scale = run.batch.scale;
-  if (const size_t rescaled = CountScansAtAnotherScale(scale); rescaled > 0) {
-    std::fprintf(stderr,
-                 "settings: %zu of %zu scans reach over %g times nearer or farther than the "
-                 "measured ones (median range %.3g m); their pairs search at settings scaled to "
-                 "fit\n",
-                 rescaled, run.batch.scans.size(), kSameScaleFactor, scale.reference_range);
+  if (const std::string rescaled = DescribeScansAtAnotherScale(run.batch.scale);
+      !rescaled.empty()) {
+    std::fprintf(stderr, "settings: %s\n", rescaled.c_str());
   }
 }
 

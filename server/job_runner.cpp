@@ -141,13 +141,9 @@ class JobRun : public MapProgressSink {
     spdlog::info("job {} running: {} scans, {} pairing, preset {}, {} of {} pairs already done",
                  job_.job_id(), spec_.batch.scans.size(), PairingModeName(spec_.batch.pairing.mode),
                  spec_.batch.config.preset, counts.done, counts.total);
-    const BatchScale& scale = spec_.batch.scale;
-    if (const size_t rescaled = CountScansAtAnotherScale(scale); rescaled > 0) {
-      spdlog::info(
-          "job {}: {} of {} scans reach over {} times nearer or farther than the "
-          "measured ones ({:.3g} m); their pairs search at settings scaled to fit",
-          job_.job_id(), rescaled, spec_.batch.scans.size(), kSameScaleFactor,
-          scale.reference_range);
+    if (const std::string rescaled = DescribeScansAtAnotherScale(spec_.batch.scale);
+        !rescaled.empty()) {
+      spdlog::info("job {}: {}", job_.job_id(), rescaled);
     }
   }
 

@@ -12,6 +12,7 @@ namespace boicp {
 namespace {
 
 using ::testing::ElementsAre;
+using ::testing::StartsWith;
 
 // A profile of points at `ranges` metres, one point each along +x.
 RangeProfile ProfileAt(const std::vector<double>& ranges) {
@@ -39,10 +40,12 @@ TEST(PairScale, APairWithinTwiceTheReferenceKeepsTheBatchsSettings) {
   EXPECT_TRUE(ScanAtAnotherScale(scale, 2));
   EXPECT_FALSE(ScanAtAnotherScale(scale, 1));
   EXPECT_FALSE(ScanAtAnotherScale(scale, 5));
-  EXPECT_EQ(CountScansAtAnotherScale(scale), 4u);  // 1.25, 1.25, 80 and 4 m
-  scale.reference_range = 0.0;                     // settings not chosen from the scans
+  EXPECT_THAT(DescribeScansAtAnotherScale(scale),  // 1.25, 1.25, 80 and 4 m
+              StartsWith("4 of 7 scans reach over 2 times nearer or farther"));
+  scale.reference_range = 0.0;  // settings not chosen from the scans
   EXPECT_EQ(PairScaleStep(scale, {2, 3}), 0);
   EXPECT_FALSE(ScanAtAnotherScale(scale, 2));
+  EXPECT_EQ(DescribeScansAtAnotherScale(scale), "");
 }
 
 TEST(PairScale, OnlyTheLengthsChosenFromTheScansAreScaled) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace boicp {
 
@@ -73,10 +74,16 @@ bool ScanAtAnotherScale(const BatchScale& scale, size_t index) {
   return !SameScale(ScaleOctaves(scale, RangeOf(scale, index)));
 }
 
-size_t CountScansAtAnotherScale(const BatchScale& scale) {
+std::string DescribeScansAtAnotherScale(const BatchScale& scale) {
   size_t count = 0;
   for (size_t i = 0; i < scale.scan_ranges.size(); ++i) count += ScanAtAnotherScale(scale, i);
-  return count;
+  if (count == 0) return "";
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "%zu of %zu scans reach over %g times nearer or farther than the measured ones "
+                "(median range %.3g m); their pairs search at settings scaled to fit",
+                count, scale.scan_ranges.size(), kSameScaleFactor, scale.reference_range);
+  return text;
 }
 
 BoIcpConfig ScaledConfig(const BoIcpConfig& config, const BatchScale& scale, int step) {
