@@ -15,7 +15,7 @@ PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libssl-dev openssl
   libspdlog-dev libfmt-dev libnlopt-cxx-dev libsqlite3-dev libsqlitecpp-dev libtbb-dev
   libnanoflann-dev libcli11-dev nlohmann-json3-dev libpng-dev zlib1g-dev
-  librosbag-storage-dev libzstd-dev liblz4-dev
+  librosbag-storage-dev libzstd-dev liblz4-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
   python3-dev pybind11-dev python3-pytest python3-grpcio python3-protobuf
@@ -28,7 +28,7 @@ RUNTIME_PACKAGES=(
   libc6 libgcc-s1 libstdc++6
   libopen3d0.16 liboctomap1.9 libnlopt0 libfmt9 libspdlog1.10 libsqlite3-0 libssl3
   libgrpc++1.51 libgrpc29 libprotobuf32 libabsl20220623 libtbb12
-  libbz2-1.0 liblz4-1 libzstd1 zlib1g
+  libbz2-1.0 liblz4-1 libzstd1 zlib1g libceres3 libgoogle-glog0v6
 )
 
 case "${1:-}" in

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "boicp/io/synthetic_scene.hpp"
+#include "boicp/mapping/chain_uncertainty.hpp"
 #include "boicp/mapping/pose_graph.hpp"
 #include "evaluation.hpp"
 
@@ -191,6 +192,178 @@ TEST(OptimizePoseGraph, DoubtfulLoopClosureThatAgreesIsKept) {
   EXPECT_TRUE(optimised.kept.back());
   EXPECT_GT(optimised.line_process.back(), 0.9);
   EXPECT_LT(MaxTranslationError(optimised.poses, truth), 1e-6);
+}
+
+// ---- Calibrated information: loops on a drifted chain ---------------------
+
+// A drive `laps` times around a circle of radius 5 m, `per_lap` scans a lap.
+std::vector<Transform> Laps(int laps, int per_lap) {
+  std::vector<Transform> poses;
+  for (int i = 0; i < laps * per_lap; ++i) {
+    const double a = 2.0 * M_PI * i / per_lap;
+    poses.push_back(Pose(a + M_PI / 2, 5 * std::cos(a), 5 * std::sin(a)));
+  }
+  return poses;
+}
+
+// Information shaped as PairInformation gives it: 5000 inliers spread 2 m
+// about the target's origin.
+InformationMatrix FiveThousandInliers() {
+  InformationMatrix information = InformationMatrix::Identity() * 5000.0;
+  information.topLeftCorner<3, 3>() *= 4.0;
+  return information;
+}
+
+// The odometry chain of `truth`, each step off by a small yaw and forward bias.
+std::vector<PairConstraint> DriftingChain(const std::vector<Transform>& truth) {
+  std::vector<PairConstraint> chain;
+  const Transform bias = Pose(0.003, 0.005, 0.0);
+  for (size_t i = 0; i + 1 < truth.size(); ++i) {
+    chain.push_back({{static_cast<int>(i), static_cast<int>(i + 1)},
+                     Transform(Relative(truth[i + 1], truth[i]) * bias),
+                     FiveThousandInliers()});
+  }
+  return chain;
+}
+
+// Root-mean-square translation error over the poses, metres (scan 0 is fixed
+// in both, so no alignment is needed).
+double RmsTranslationError(const std::vector<Transform>& poses,
+                           const std::vector<Transform>& truth) {
+  double sum = 0.0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    sum += std::pow(TranslationErrorM(poses[i], truth[i]), 2);
+  }
+  return std::sqrt(sum / static_cast<double>(poses.size()));
+}
+
+PoseGraphOptions CalibratedOptions() {
+  PoseGraphOptions options;
+  options.max_correspondence_distance = 0.05;
+  options.pair_error = 0.015;
+  return options;
+}
+
+TEST(CalibratedInformation, IsTheMeanInlierInformationOverTheErrorSquared) {
+  const InformationMatrix calibrated = CalibratedInformation(FiveThousandInliers(), 0.01);
+  EXPECT_NEAR(calibrated(3, 3), 1e4, 1e4 * 2 * kMinEdgeWeight);  // 1 / (1 cm)^2 along each axis
+  EXPECT_NEAR(calibrated(0, 0), 4e4, 1e4 * 2 * kMinEdgeWeight);  // the inliers' spread stays
+  EXPECT_NEAR(calibrated(0, 3), 0.0, 1e-9);
+  // A wall: every inlier faces x, so y and z are free but for the floor.
+  InformationMatrix wall = InformationMatrix::Zero();
+  wall(3, 3) = 3000.0;
+  const InformationMatrix along_wall = CalibratedInformation(wall, 0.01);
+  EXPECT_NEAR(along_wall(3, 3), 3e4, 20.0);
+  EXPECT_NEAR(along_wall(4, 4), kMinEdgeWeight * 1e4, 1e-9);
+  EXPECT_NEAR(CalibratedInformation(InformationMatrix::Zero(), 0.01)(0, 0), kMinEdgeWeight * 1e4,
+              1e-9);
+}
+
+TEST(ChainUncertainty, GrowsAlongTheChainAndIsSymmetric) {
+  const std::vector<Transform> truth = Laps(1, 40);
+  std::vector<PairConstraint> chain = DriftingChain(truth);
+  for (PairConstraint& c : chain) {
+    c.T_target_source = Relative(truth[static_cast<size_t>(c.pair.target)],
+                                 truth[static_cast<size_t>(c.pair.source)]);
+    c.information = CalibratedInformation(c.information, 0.01);
+  }
+  const ChainedPoses chained = ChainPoses(40, chain);
+  const ChainUncertainty uncertainty(chained.poses, chain, chained.in_tree);
+  const auto translation_variance = [&](int a, int b) {
+    return uncertainty.Between(a, b).bottomRightCorner(3, 3).trace();
+  };
+  double previous = 0.0;
+  for (int k = 1; k < 40; k += 6) {
+    EXPECT_GT(translation_variance(0, k), previous) << k;
+    previous = translation_variance(0, k);
+  }
+  // The edge's own measurement, T_1_0: its translation variance, 3 x (1 cm)^2.
+  EXPECT_NEAR(translation_variance(1, 0), 3e-4, 1e-6);
+  // Walking the other way round gives about the same uncertainty.
+  EXPECT_NEAR(translation_variance(5, 20), translation_variance(20, 5),
+              0.2 * translation_variance(5, 20));
+}
+
+TEST(OptimizePoseGraph, CalibratedInformationKeepsARightLoopOnADriftedChain) {
+  const std::vector<Transform> truth = Laps(1, 40);
+  std::vector<PairConstraint> constraints = DriftingChain(truth);
+  constraints.push_back({{39, 0}, Relative(truth[0], truth[39]), FiveThousandInliers()});
+  const ChainedPoses chained = ChainPoses(40, constraints, truth[0]);
+  const double drift = MaxTranslationError(chained.poses, truth);
+  ASSERT_GT(drift, 0.2);  // the chain's end is off by more than its pairs' errors add up to
+
+  // Information counting every inlier as independent makes the drift look
+  // like an outlier: the loop is pruned and nothing improves.
+  PoseGraphOptions per_inlier = CalibratedOptions();
+  per_inlier.pair_error = 0.0;
+  const OptimizedPoses pruned =
+      OptimizePoseGraph(chained.poses, constraints, chained.in_tree, per_inlier);
+  EXPECT_FALSE(pruned.kept.back());
+
+  const OptimizedPoses kept =
+      OptimizePoseGraph(chained.poses, constraints, chained.in_tree, CalibratedOptions());
+  EXPECT_TRUE(kept.kept.back()) << kept.left_out_because.back();
+  EXPECT_TRUE(kept.left_out_because.back().empty());
+  EXPECT_LT(RmsTranslationError(kept.poses, truth),
+            0.3 * RmsTranslationError(chained.poses, truth));
+}
+
+TEST(OptimizePoseGraph, CalibratedInformationLeavesOutAWrongTrustedLoop) {
+  const std::vector<Transform> truth = Laps(1, 40);
+  std::vector<PairConstraint> constraints = DriftingChain(truth);
+  // A right loop, and a wrong one: 20 -> 5 put 2 m and 40 degrees off.
+  constraints.push_back({{39, 0}, Relative(truth[0], truth[39]), FiveThousandInliers()});
+  constraints.push_back({{20, 5},
+                         Transform(Relative(truth[5], truth[20]) * Pose(0.7, 2.0, 0.0)),
+                         FiveThousandInliers()});
+  const ChainedPoses chained = ChainPoses(40, constraints, truth[0]);
+  const OptimizedPoses optimised =
+      OptimizePoseGraph(chained.poses, constraints, chained.in_tree, CalibratedOptions());
+  EXPECT_TRUE(optimised.kept[constraints.size() - 2]);
+  EXPECT_FALSE(optimised.kept.back());
+  EXPECT_NE(optimised.left_out_because.back().find("disagrees"), std::string::npos)
+      << optimised.left_out_because.back();
+}
+
+TEST(OptimizePoseGraph, TwentyPercentWrongTrustedLoopsAtMostDoubleTheError) {
+  // Two laps: each scan of the second passes its twin of the first.
+  const std::vector<Transform> truth = Laps(2, 40);
+  const std::vector<PairConstraint> chain = DriftingChain(truth);
+  std::vector<PairConstraint> right = chain;
+  for (int k = 2; k < 40; k += 5) {  // 8 right loops
+    right.push_back({{k + 40, k},
+                     Relative(truth[static_cast<size_t>(k)], truth[static_cast<size_t>(k + 40)]),
+                     FiveThousandInliers()});
+  }
+  const auto rms_after = [&](const std::vector<PairConstraint>& constraints) {
+    const ChainedPoses chained = ChainPoses(80, constraints, truth[0]);
+    const OptimizedPoses optimised =
+        OptimizePoseGraph(chained.poses, constraints, chained.in_tree, CalibratedOptions());
+    return RmsTranslationError(optimised.poses, truth);
+  };
+  const double clean = rms_after(right);
+  EXPECT_LT(clean, 0.5 * rms_after(chain));
+
+  // 2 wrong loops among 10 (20 %), trusted like the right ones, drawn at
+  // random: between unrelated scans or the right ones, 0.3 to 3 m and up to
+  // 60 degrees off.
+  std::mt19937 rng(20261207);
+  std::uniform_int_distribution<int> scan(0, 79);
+  std::uniform_real_distribution<double> offset(0.3, 3.0), yaw(-1.05, 1.05);
+  for (int trial = 0; trial < 10; ++trial) {
+    std::vector<PairConstraint> noisy = right;
+    for (int wrong = 0; wrong < 2; ++wrong) {
+      int a = scan(rng), b = scan(rng);
+      while (std::abs(a - b) < 10) b = scan(rng);
+      const Transform off = Pose(yaw(rng), offset(rng), offset(rng) - 1.5);
+      noisy.push_back({{std::max(a, b), std::min(a, b)},
+                       Transform(Relative(truth[static_cast<size_t>(std::min(a, b))],
+                                          truth[static_cast<size_t>(std::max(a, b))]) *
+                                 off),
+                       FiveThousandInliers()});
+    }
+    EXPECT_LT(rms_after(noisy), 2.0 * clean) << "trial " << trial;
+  }
 }
 
 }  // namespace

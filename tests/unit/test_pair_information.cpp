@@ -71,9 +71,39 @@ TEST(PairInformation, RegisterPairReportsItForTheFinestLevelInliers) {
   const size_t finest_points = PreparePair(source, target, config).pyramid.back().source.size();
   const double inliers = result.fitness * static_cast<double>(finest_points);
   EXPECT_GT(inliers, 100.0);
-  for (int axis = 3; axis < 6; ++axis) EXPECT_NEAR(result.information(axis, axis), inliers, 0.5);
+  // Point-to-plane: each inlier with a normal adds 1 to the translation
+  // block's trace.
+  const double with_normals = result.information.bottomRightCorner<3, 3>().trace();
+  EXPECT_LE(with_normals, inliers + 0.5);
+  EXPECT_GT(with_normals, 0.8 * inliers);
   const Eigen::SelfAdjointEigenSolver<InformationMatrix> spectrum(result.information);
   EXPECT_GT(spectrum.eigenvalues().minCoeff(), 0.0);
+}
+
+// A flat wall pins the pose down only across itself: sliding along it, or
+// turning about its normal, moves no match off its plane.
+TEST(PlaneInformation, AWallLeavesItsOwnDirectionsFree) {
+  Points wall;
+  for (int i = 0; i < 60; ++i) {
+    for (int j = 0; j < 40; ++j) wall.emplace_back(5.0, -3.0 + 0.1 * i, -1.0 + 0.05 * j);
+  }
+  const NearestNeighborIndex index(wall);
+  const InformationMatrix info = PlaneInformation(wall, index, Transform::Identity(), 0.2, 0.3);
+  const Eigen::Matrix3d translation = info.bottomRightCorner<3, 3>();
+  EXPECT_NEAR(translation(0, 0), static_cast<double>(wall.size()), 1e-6);  // across the wall
+  EXPECT_NEAR(translation(1, 1), 0.0, 1e-9);
+  EXPECT_NEAR(translation(2, 2), 0.0, 1e-9);
+  const Eigen::SelfAdjointEigenSolver<InformationMatrix> spectrum(info);
+  // Three directions of 6 are free: two slides and the turn about x.
+  EXPECT_NEAR(spectrum.eigenvalues()(2), 0.0, 1e-6 * spectrum.eigenvalues()(5));
+
+  // A street's scan constrains every direction.
+  const Points street = SimulateScan(MakeSyntheticStreet(3, 10.0),
+                                     PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8}), 20.0, 0.0, 1);
+  const InformationMatrix street_info =
+      PlaneInformation(street, NearestNeighborIndex(street), Transform::Identity(), 0.3, 1.0);
+  const Eigen::SelfAdjointEigenSolver<InformationMatrix> street_spectrum(street_info);
+  EXPECT_GT(street_spectrum.eigenvalues()(0), 1e-3 * street_spectrum.eigenvalues()(5));
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "boicp/icp/pair_information.hpp"
 
+#include "boicp/icp/surface_normals.hpp"
+
 namespace boicp {
 
 InformationMatrix PairInformation(const Points& source, const NearestNeighborIndex& target,
@@ -16,6 +18,24 @@ InformationMatrix PairInformation(const Points& source, const NearestNeighborInd
         -q.z(), 0.0, q.x(), 0.0, 1.0, 0.0,          //
         q.y(), -q.x(), 0.0, 0.0, 0.0, 1.0;
     information += jacobian.transpose() * jacobian;
+  }
+  return information;
+}
+
+InformationMatrix PlaneInformation(const Points& source, const NearestNeighborIndex& target,
+                                   const Transform& T_target_source, double max_distance,
+                                   double normal_radius) {
+  InformationMatrix information = InformationMatrix::Zero();
+  const double max_squared = max_distance * max_distance;
+  for (const Point& p : TransformPoints(T_target_source, source)) {
+    size_t match = 0;
+    double squared = 0.0;
+    if (!target.Nearest(p, max_squared, match, squared)) continue;
+    const Point& q = target.points()[match];
+    const Point n = SurfaceNormalAt(target, q, normal_radius);
+    Eigen::Matrix<double, 6, 1> jacobian;
+    jacobian << q.cross(n), n;
+    information += jacobian * jacobian.transpose();
   }
   return information;
 }

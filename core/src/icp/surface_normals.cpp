@@ -33,6 +33,13 @@ Point PlaneNormal(const Points& points, const std::vector<size_t>& neighbours) {
 
 }  // namespace
 
+Point SurfaceNormalAt(const NearestNeighborIndex& cloud, const Point& at, double radius) {
+  std::vector<size_t> neighbours;
+  cloud.KNearest(at, kNeighbours, radius * radius, neighbours);
+  if (neighbours.size() < kFewestNeighbours) return Point::Zero();
+  return PlaneNormal(cloud.points(), neighbours);
+}
+
 Points EstimateSurfaceNormals(const NearestNeighborIndex& cloud, double radius, int threads) {
   const Points& points = cloud.points();
   Points normals(points.size(), Point::Zero());

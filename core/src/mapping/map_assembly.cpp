@@ -88,12 +88,14 @@ PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
   if (chained.loop_closures == 0) {
     estimate.poses = chained.poses;
     estimate.kept.assign(constraints.size(), true);
+    estimate.left_out_because.assign(constraints.size(), "");
     return estimate;
   }
   OptimizedPoses optimised =
       OptimizePoseGraph(chained.poses, constraints, chained.in_tree, options);
   estimate.poses = std::move(optimised.poses);
   estimate.kept = std::move(optimised.kept);
+  estimate.left_out_because = std::move(optimised.left_out_because);
   estimate.optimised = true;
   return estimate;
 }

@@ -1,14 +1,19 @@
 #include "boicp/mapping/pose_graph.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <deque>
 #include <numeric>
+#include <optional>
 #include <string>
 
 #include <open3d/pipelines/registration/GlobalOptimization.h>
 #include <open3d/pipelines/registration/GlobalOptimizationConvergenceCriteria.h>
 #include <open3d/pipelines/registration/GlobalOptimizationMethod.h>
 #include <open3d/pipelines/registration/PoseGraph.h>
+
+#include "boicp/mapping/chain_uncertainty.hpp"
+#include "boicp/mapping/robust_pose_graph.hpp"
 
 namespace boicp {
 namespace {
@@ -45,44 +50,60 @@ double LineProcessScale(const std::vector<PairConstraint>& constraints,
 }
 
 // The line-process weight (mu / (mu + r^2))^2 a loop closure starts with
-// under `poses`: r^2 = e^T I e, with e Open3D's linearised misalignment
-// (rotation first) of T_target_source against the poses and I the edge's
-// full information. 1 = the poses agree with it exactly.
+// under `poses`: r^2 = e^T I e, with e its misfit (ConstraintMisfit) and I
+// the edge's full information. 1 = the poses agree with it exactly.
 double AgreementWithPoses(const PairConstraint& c, const std::vector<Transform>& poses, double mu) {
-  const Eigen::Matrix4d misfit =
-      (c.T_target_source.inverse() * poses[static_cast<size_t>(c.pair.target)].inverse() *
-       poses[static_cast<size_t>(c.pair.source)])
-          .matrix();
-  Eigen::Matrix<double, 6, 1> e;
-  e << (misfit(2, 1) - misfit(1, 2)) / 2.0, (misfit(0, 2) - misfit(2, 0)) / 2.0,
-      (misfit(1, 0) - misfit(0, 1)) / 2.0, misfit(0, 3), misfit(1, 3), misfit(2, 3);
+  const Eigen::Matrix<double, 6, 1> e = ConstraintMisfit(c, poses);
   const double r2 = e.dot(c.information * e);
   if (!(mu > 0.0)) return r2 > 0.0 ? 0.0 : 1.0;
   const double w = mu / (mu + r2);
   return w * w;
 }
 
-// Open3D's pose graph over the active constraints, each edge's information
-// scaled by its weight. Kept (and the final line-process weight) per
-// constraint; false for inactive or pruned ones.
-OptimizedPoses OptimizeActiveEdges(const std::vector<Transform>& initial,
-                                   const std::vector<PairConstraint>& constraints,
-                                   const std::vector<bool>& in_tree,
-                                   const std::vector<bool>& active,
-                                   const PoseGraphOptions& options) {
+// `c` with its information scaled by its weight, as the optimisation uses it.
+PairConstraint Weighted(PairConstraint c) {
+  c.information *= EdgeWeight(c);
+  return c;
+}
+
+std::vector<PairConstraint> Weighted(std::vector<PairConstraint> constraints) {
+  for (PairConstraint& c : constraints) c = Weighted(c);
+  return constraints;
+}
+
+std::string FormatChi2(double chi2) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3g", chi2);
+  return text;
+}
+
+// How a constraint enters the optimisation.
+enum class EdgeRole {
+  kTree,           // certain: a spanning-tree edge
+  kCertainLoop,    // certain: a trusted loop closure the chain agrees with
+  kUncertainLoop,  // Open3D's line process may weigh it down and prune it
+  kLeftOut,
+};
+
+// Open3D's pose graph over the constraints not left out, each edge's
+// information scaled by its weight. Kept (and the final line-process
+// weight) per constraint; false for those left out or pruned.
+OptimizedPoses OptimizeEdges(const std::vector<Transform>& initial,
+                             const std::vector<PairConstraint>& constraints,
+                             const std::vector<EdgeRole>& roles, const PoseGraphOptions& options) {
   reg::PoseGraph graph;
   for (const Transform& pose : initial) graph.nodes_.emplace_back(pose);
   std::vector<size_t> edge_of;  // graph edge -> constraint
   for (size_t e = 0; e < constraints.size(); ++e) {
-    if (!active[e]) continue;
+    if (roles[e] == EdgeRole::kLeftOut) continue;
     const PairConstraint& c = constraints[e];
     const double weight = EdgeWeight(c);
-    const bool loop_closure = IsLoopClosure(in_tree, e);
-    // Open3D requires confidence 1 on certain (tree) edges; a loop closure's
-    // line process starts from the pair's confidence.
+    const bool uncertain = roles[e] == EdgeRole::kUncertainLoop;
+    // Open3D requires confidence 1 on certain edges; an uncertain loop
+    // closure's line process starts from the pair's confidence.
     graph.edges_.emplace_back(c.pair.source, c.pair.target, c.T_target_source,
-                              InformationMatrix(c.information * weight),
-                              /*uncertain=*/loop_closure, loop_closure ? weight : 1.0);
+                              InformationMatrix(c.information * weight), uncertain,
+                              uncertain ? weight : 1.0);
     edge_of.push_back(e);
   }
   reg::GlobalOptimizationConvergenceCriteria criteria;
@@ -103,6 +124,7 @@ OptimizedPoses OptimizeActiveEdges(const std::vector<Transform>& initial,
   // survivors back to the input.
   out.kept.assign(constraints.size(), false);
   out.line_process.assign(constraints.size(), 0.0);
+  out.left_out_because.assign(constraints.size(), "");
   size_t next = 0;
   for (const auto& edge : graph.edges_) {
     while (next < edge_of.size() && std::make_pair(edge.source_node_id_, edge.target_node_id_) !=
@@ -118,7 +140,43 @@ OptimizedPoses OptimizeActiveEdges(const std::vector<Transform>& initial,
   return out;
 }
 
+// The robust optimisation (SolveRobustPoseGraph) over the constraints not
+// left out, each information scaled by its weight; the loss's weight at the
+// solution stands for the line process.
+OptimizedPoses OptimizeRobustly(const std::vector<Transform>& initial,
+                                const std::vector<PairConstraint>& constraints,
+                                const std::vector<EdgeRole>& roles) {
+  std::vector<PairConstraint> edges;
+  std::vector<size_t> edge_of;
+  for (size_t e = 0; e < constraints.size(); ++e) {
+    if (roles[e] == EdgeRole::kLeftOut) continue;
+    edges.push_back(Weighted(constraints[e]));
+    edge_of.push_back(e);
+  }
+  RobustPoseGraphSolution solution = SolveRobustPoseGraph(initial, edges);
+  OptimizedPoses out;
+  out.poses = std::move(solution.poses);
+  out.kept.assign(constraints.size(), false);
+  out.line_process.assign(constraints.size(), 0.0);
+  out.left_out_because.assign(constraints.size(), "");
+  for (size_t k = 0; k < edge_of.size(); ++k) {
+    out.kept[edge_of[k]] = true;
+    out.line_process[edge_of[k]] = solution.weights[k];
+  }
+  return out;
+}
+
 }  // namespace
+
+InformationMatrix CalibratedInformation(const InformationMatrix& information, double pair_error) {
+  const double variance = pair_error * pair_error;
+  // A direction no inlier constrains keeps a little information, so the
+  // graph stays well posed; the pair then barely pulls along it.
+  const InformationMatrix floor = InformationMatrix::Identity() * (kMinEdgeWeight / variance);
+  const double inliers = information.bottomRightCorner<3, 3>().trace() / 3.0;
+  if (!(inliers > 0.0)) return floor;
+  return information / (inliers * variance) + floor;
+}
 
 bool IsDoubtfulEdge(const PairConstraint& constraint) {
   return constraint.confidence < kDoubtfulBelow;
@@ -193,14 +251,11 @@ ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constr
 }
 
 OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
-                                 const std::vector<PairConstraint>& constraints,
+                                 const std::vector<PairConstraint>& given,
                                  const std::vector<bool>& in_tree,
                                  const PoseGraphOptions& options) {
-  // A doubtful loop closure has no evidence of its own: it joins only when
-  // the poses chained from the tree (trusted pairs first) agree with it at
-  // full weight. Scaled down first, a wrong one would look consistent.
-  const double mu = LineProcessScale(constraints, options);
-  std::vector<bool> active(constraints.size(), true);
+  const bool calibrated = options.pair_error > 0.0;
+  std::vector<PairConstraint> constraints = given;
   for (size_t e = 0; e < constraints.size(); ++e) {
     const PairIndex& p = constraints[e].pair;
     const int n = static_cast<int>(initial.size());
@@ -208,12 +263,80 @@ OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,
       throw InputError("pose graph: constraint " + std::to_string(e) +
                        " has an index out of range");
     }
-    if (IsLoopClosure(in_tree, e) && IsDoubtfulEdge(constraints[e])) {
-      active[e] =
-          AgreementWithPoses(constraints[e], initial, mu) >= options.doubtful_keep_threshold;
+    if (calibrated) {
+      constraints[e].information =
+          CalibratedInformation(constraints[e].information, options.pair_error);
     }
   }
-  return OptimizeActiveEdges(initial, constraints, in_tree, active, options);
+
+  // A doubtful loop closure has no evidence of its own: it joins only when
+  // the poses chained from the tree (trusted pairs first) agree with it at
+  // full weight. Scaled down first, a wrong one would look consistent.
+  // A trusted one, with calibrated information, joins as a certain edge when
+  // it disagrees with the chain by no more than the chain and the pair may
+  // err together (ChainUncertainty): a right loop closing a drifted chain
+  // disagrees with it by the drift, which the line process would take for
+  // an outlier.
+  const double mu = LineProcessScale(constraints, options);
+  std::vector<EdgeRole> roles(constraints.size(), EdgeRole::kTree);
+  std::vector<std::string> reasons(constraints.size());
+  std::optional<ChainUncertainty> chain;
+  for (size_t e = 0; e < constraints.size(); ++e) {
+    if (!IsLoopClosure(in_tree, e)) continue;
+    const PairConstraint& c = constraints[e];
+    if (IsDoubtfulEdge(c)) {
+      const bool agrees = AgreementWithPoses(c, initial, mu) >= options.doubtful_keep_threshold;
+      roles[e] = agrees ? EdgeRole::kUncertainLoop : EdgeRole::kLeftOut;
+      if (!agrees) reasons[e] = "doubtful, and the chained poses disagree with it";
+      continue;
+    }
+    if (!calibrated) {
+      roles[e] = EdgeRole::kUncertainLoop;
+      continue;
+    }
+    if (!chain) chain.emplace(initial, Weighted(constraints), in_tree);
+    const double chi2 = chain->LoopDisagreement(Weighted(c));
+    roles[e] = chi2 <= kLoopAgreementChi2 ? EdgeRole::kCertainLoop : EdgeRole::kLeftOut;
+    if (roles[e] == EdgeRole::kLeftOut) {
+      reasons[e] = "disagrees with the chained poses beyond their uncertainty (chi-square " +
+                   FormatChi2(chi2) + ")";
+    }
+  }
+
+  // Loop closures that each agree with the chain may still contradict one
+  // another: after the optimisation, the one that fits the result worst is
+  // left out, until every certain loop closure (with calibrated information:
+  // every loop closure) fits.
+  for (;;) {
+    OptimizedPoses out = calibrated ? OptimizeRobustly(initial, constraints, roles)
+                                    : OptimizeEdges(initial, constraints, roles, options);
+    size_t worst = constraints.size();
+    double worst_chi2 = kLoopAgreementChi2;
+    for (size_t e = 0; e < constraints.size(); ++e) {
+      const bool loop = roles[e] == EdgeRole::kCertainLoop ||
+                        (calibrated && roles[e] == EdgeRole::kUncertainLoop);
+      if (!loop) continue;
+      const Eigen::Matrix<double, 6, 1> misfit = ConstraintMisfit(constraints[e], out.poses);
+      const double chi2 = misfit.dot(Weighted(constraints[e]).information * misfit);
+      if (chi2 > worst_chi2) {
+        worst = e;
+        worst_chi2 = chi2;
+      }
+    }
+    if (worst == constraints.size()) {
+      for (size_t e = 0; e < constraints.size(); ++e) {
+        if (!reasons[e].empty()) {
+          out.left_out_because[e] = reasons[e];
+        } else if (!out.kept[e]) {
+          out.left_out_because[e] = "pruned by the optimisation as an outlier";
+        }
+      }
+      return out;
+    }
+    roles[worst] = EdgeRole::kLeftOut;
+    reasons[worst] = "contradicts the other loop closures (chi-square " + FormatChi2(worst_chi2) +
+                     " after the optimisation)";
+  }
 }
 
 }  // namespace boicp

@@ -362,8 +362,8 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   result.inlier_rmse = kept.refined.score.inlier_rmse;
   const PyramidLevel& finest = kept.prepared->pyramid.back();
   result.information =
-      MovedInformation(PairInformation(finest.source, finest.target, kept.refined.transform,
-                                       config.EffectiveInlierDistance()),
+      MovedInformation(PlaneInformation(finest.source, finest.target, kept.refined.transform,
+                                        config.EffectiveInlierDistance(), 3.0 * finest.voxel),
                        target.centre);
   result.overlap = kept.overlap;
   result.search_reach = SearchReach(kept.box, kept.refined.transform);

@@ -20,6 +20,17 @@ using InformationMatrix = Eigen::Matrix<double, 6, 6>;
 InformationMatrix PairInformation(const Points& source, const NearestNeighborIndex& target,
                                   const Transform& T_target_source, double max_distance);
 
+/// The point-to-plane information of the same matches: the sum of J^T J
+/// with J = n^T [-[q]x | I], n the target's surface normal at q
+/// (SurfaceNormalAt, within `normal_radius` metres). A match moves only
+/// along its surface's normal, so a direction no surface faces (along a
+/// wall, a corridor, a floor) gets no information: the geometry does not
+/// constrain it. The trace of the translation block counts the matches
+/// with a normal. Zero when nothing matches.
+InformationMatrix PlaneInformation(const Points& source, const NearestNeighborIndex& target,
+                                   const Transform& T_target_source, double max_distance,
+                                   double normal_radius);
+
 /// The information of the same matches with every target point moved by
 /// `offset` metres (q + offset): A^T * information * A with
 /// A = [I 0; -[offset]x I], exactly what PairInformation gives on the moved

@@ -14,4 +14,9 @@ namespace boicp {
 /// sign is arbitrary. The result does not depend on `threads` (>= 1).
 Points EstimateSurfaceNormals(const NearestNeighborIndex& cloud, double radius, int threads);
 
+/// The same normal for one point `at` (usually a point of `cloud`), from its
+/// 10 nearest points of `cloud` within `radius` metres; zero when they are
+/// too few or lie on a line.
+Point SurfaceNormalAt(const NearestNeighborIndex& cloud, const Point& at, double radius);
+
 }  // namespace boicp

@@ -10,6 +10,7 @@
 
 #include "boicp/io/point_cloud_io.hpp"
 #include "boicp/io/scan_source.hpp"
+#include "boicp/mapping/loop_candidates.hpp"
 #include "boicp/mapping/map_stage.hpp"
 #include "boicp/mapping/occupancy_map.hpp"
 #include "boicp/mapping/pose_graph.hpp"
@@ -23,6 +24,8 @@ struct PoseEstimate {
   /// Per constraint: used by the final poses (false for loop closures the
   /// optimisation pruned or, being doubtful, left out).
   std::vector<bool> kept;
+  /// Per constraint: why it is not kept (OptimizedPoses::left_out_because).
+  std::vector<std::string> left_out_because;
 };
 
 /// Chains the constraints (listed with the sequential chain first; trusted
@@ -46,6 +49,7 @@ struct MapBuildSettings {
   /// tree, a quarter for the ray-cast cells of the scans in flight. FuseScans throws
   /// LimitExceeded, naming --max-fusion-mb, rather than pass it.
   size_t max_fusion_bytes = 0;
+  LoopSearch loops = LoopSearch::kAuto;  // whether the map looks for loop closures itself
 };
 
 /// Where to write each output; an empty path skips that output. Every file

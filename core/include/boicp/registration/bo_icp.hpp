@@ -83,8 +83,9 @@ struct RegistrationResult {
   double objective = 0.0;
   double fitness = 0.0;      // fraction of refined source points within inlier_distance
   double inlier_rmse = 0.0;  // RMS distance of those points, metres
-  /// How firmly those inliers pin down `transform` (PairInformation over the
-  /// refined source points, within inlier_distance): a pose graph's edge weight.
+  /// How firmly those inliers pin down `transform` (PlaneInformation over
+  /// the refined source points, within inlier_distance): a pose graph's edge
+  /// weight, weak along directions the surfaces do not constrain.
   InformationMatrix information = InformationMatrix::Zero();
   /// Fraction of the search-voxel source within 1.5 search voxels of the
   /// target: how much of the source the target sees, for keyframe choice.
