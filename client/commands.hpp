@@ -19,6 +19,7 @@ CommandRunner AddMapCommand(CLI::App& app);
 CommandRunner AddPreviewCommand(CLI::App& app);
 CommandRunner AddMergeCommand(CLI::App& app);
 CommandRunner AddInfoCommand(CLI::App& app);
+CommandRunner AddEvalCommand(CLI::App& app);
 
 #ifdef BOICP_WITH_REMOTE_COMMANDS
 // Talking to the daemon boicpd (built with it).

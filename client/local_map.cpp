@@ -29,15 +29,16 @@ MapOutputPaths LocalOutputPaths(const std::string& out_dir) {
   return paths;
 }
 
-// The pairs pairs.json lists: a fixed plan's, in plan order; for keyframes
-// every probe, in index order.
+// The pairs pairs.json lists: a fixed plan's, in plan order, then the loop
+// candidates; for keyframes every pair, in index order.
 std::vector<PairIndex> ListedPairs(const PairingPlan& plan, const RegisteredPairs& registered) {
+  std::vector<PairIndex> listed;
   if (!plan.keyframes) {
-    std::vector<PairIndex> listed = plan.chain;
+    listed = plan.chain;
     listed.insert(listed.end(), plan.extras.begin(), plan.extras.end());
+    listed.insert(listed.end(), registered.loops.begin(), registered.loops.end());
     return listed;
   }
-  std::vector<PairIndex> listed;
   for (const auto& entry : registered.finished) listed.push_back(entry.first);
   return listed;
 }
@@ -58,6 +59,8 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   json listing = json::array();
   for (PairResult& r : listed) {
     r.in_graph = in_graph.count(r.pair) > 0;
+    const auto reason = map.left_out.find(r.pair);
+    if (reason != map.left_out.end()) r.left_out_because = reason->second;
     listing.push_back(PairListingJson(run.batch.scans, r));
   }
   WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
@@ -102,6 +105,8 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
   std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
   const std::string rungs = settings::RungSummary(summary.answered_by);
   if (!rungs.empty()) std::fprintf(stderr, "%s\n", rungs.c_str());
+  const std::string loops = summary.loops.Line();
+  if (!loops.empty()) std::fprintf(stderr, "%s\n", loops.c_str());
 }
 
 MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, int threads,
@@ -124,6 +129,7 @@ MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, 
   }
   MapOutputSummary summary = WriteListingAndPreview(run, result.map, listed, out_dir);
   summary.pairs_reused = result.pairs.reused;
+  summary.loops = SummariseLoops(result.pairs, result.map.in_graph);
   return summary;
 }
 
@@ -139,6 +145,10 @@ nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summa
           {"pairs", summary.pairs},
           {"pairs_reused", summary.pairs_reused},
           {"pairs_doubtful", summary.pairs_doubtful},
+          {"loop_candidates", summary.loops.candidates},
+          {"loops_closed", summary.loops.closed},
+          {"loop_seconds", summary.loops.seconds},
+          {"other_pair_seconds", summary.loops.other_seconds},
           {"pose_graph_optimised", summary.optimised},
           {"occupied_leaves", summary.occupied_leaves},
           {"runtime_s", seconds},
@@ -160,7 +170,7 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
 
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,
                                      const std::map<PairIndex, PairResult>& results,
-                                     const std::string& out_dir) {
+                                     const std::string& out_dir, int threads) {
   const MapBatch& batch = run.batch;
   RegisteredPairs registered;
   registered.finished = results;
@@ -168,12 +178,18 @@ MapOutputSummary AssembleStoredPairs(const LocalRun& run,
   PairFileStore store(batch.scans, batch.config, out_dir);
   TerminalProgress progress;
   fs::create_directories(out_dir);
+  if (batch.map.loops == LoopSearch::kAuto) {
+    ThreadPool pool(threads);
+    RegisterLoopCandidates(batch, registered, store, progress, LocalExecution(pool));
+  }
   const AssembledMap map =
       AssembleMap(batch, registered, store, progress, LocalOutputPaths(out_dir));
   std::vector<PairResult> listed;
   for (const PairIndex& pair : ListedPairs(batch.plan, registered))
-    listed.push_back(results.at(pair));
-  return WriteListingAndPreview(run, map, listed, out_dir);
+    listed.push_back(registered.finished.at(pair));
+  MapOutputSummary summary = WriteListingAndPreview(run, map, listed, out_dir);
+  summary.loops = SummariseLoops(registered, map.in_graph);
+  return summary;
 }
 
 }  // namespace boicp::cli

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "boicp/mapping/map_pipeline.hpp"
 #include "boicp/mapping/map_progress.hpp"
 #include "local_pipeline.hpp"
 
@@ -25,6 +26,7 @@ struct MapOutputSummary {
   int pairs_doubtful = 0;         // of which doubtful
   int pairs_reused = 0;           // taken from OUTDIR/pairs instead of registered
   std::vector<Rung> answered_by;  // of each pair listed, the rung whose answer was kept
+  LoopStageSummary loops;         // the loop closures the map looked for itself
 };
 
 /// What a caller may add to a local run: where progress goes (null: the
@@ -48,7 +50,8 @@ MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, 
                                const LocalMapHooks& hooks = {});
 
 /// `map --json`'s summary of a run written into `out_dir` in `seconds`:
-/// layout, scans, pairs (reused, doubtful), whether the pose graph was
+/// layout, scans, pairs (reused, doubtful), loop candidates, loops closed
+/// and the seconds their registration took against the other pairs', whether the pose graph was
 /// optimised, occupied leaves, runtime_s and every output file's path.
 nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summary,
                               const std::string& out_dir, double seconds);
@@ -59,9 +62,10 @@ int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,
                        const std::string& out_dir, int threads);
 
 /// `boicp merge`: the map from results already read (ReadStoredPairs, one
-/// per pair of run.batch.plan), written to OUTDIR as BuildLocalMap does.
+/// per pair of run.batch.plan), written to OUTDIR as BuildLocalMap does,
+/// with the loop stage's candidates registered on `threads` threads (>= 1).
 MapOutputSummary AssembleStoredPairs(const LocalRun& run,
                                      const std::map<PairIndex, PairResult>& results,
-                                     const std::string& out_dir);
+                                     const std::string& out_dir, int threads);
 
 }  // namespace boicp::cli

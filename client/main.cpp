@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
   add(merge, boicp::cli::AddMergeCommand(*merge));
   CLI::App* info = app.add_subcommand("info", "List a bag's topics, types, counts and duration");
   add(info, boicp::cli::AddInfoCommand(*info));
+  CLI::App* eval =
+      app.add_subcommand("eval", "Score a map's trajectory and pairs against a reference");
+  add(eval, boicp::cli::AddEvalCommand(*eval));
 #ifdef BOICP_WITH_REMOTE_COMMANDS  // talking to boicpd
   CLI::App* submit =
       app.add_subcommand("submit", "Upload a scan folder or bag and submit a job to boicpd");

@@ -50,7 +50,8 @@ int RunMerge(const MergeFlags& flags) {
                results.size());
   PrintRunSettings(run);
   WriteRunManifest(run, flags.out_dir);
-  const MapOutputSummary summary = AssembleStoredPairs(run, results, flags.out_dir);
+  const MapOutputSummary summary =
+      AssembleStoredPairs(run, results, flags.out_dir, AvailableCores());
   PrintMapClosing(summary, flags.out_dir);
   if (flags.json) {
     std::cout << json{{"scans", run.batch.scans.size()},

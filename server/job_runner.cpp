@@ -258,6 +258,10 @@ class JobRun : public MapProgressSink {
       spdlog::warn("job {}: {} points lie beyond the OctoMap's key range and were left out",
                    job_.job_id(), map.fusion.points_out_of_range);
     }
+    if (const std::string loops = SummariseLoops(result.pairs, map.in_graph).Line();
+        !loops.empty()) {
+      spdlog::info("job {}: {}", job_.job_id(), loops);
+    }
     std::vector<v1::TrajectoryPose> trajectory;
     const std::vector<double> stamps = ScanTimestamps(spec_.batch.scans);
     for (size_t i = 0; i < spec_.batch.scans.size(); ++i) {

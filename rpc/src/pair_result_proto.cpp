@@ -31,6 +31,8 @@ void SetValue(v1::PairResult* out, const pb::FieldDescriptor* field, const T& va
     reflection->SetBool(out, field, value);
   } else if constexpr (std::is_same_v<T, Rung>) {
     reflection->SetString(out, field, RungName(value));
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    reflection->SetString(out, field, value);
   } else if constexpr (std::is_same_v<T, int>) {
     reflection->SetUInt32(out, field, static_cast<uint32_t>(std::max(value, 0)));
   } else if constexpr (std::is_same_v<T, uint64_t>) {
@@ -59,6 +61,8 @@ T GetValue(const v1::PairResult& in, const pb::FieldDescriptor* field) {
     const std::optional<Rung> rung = settings::RungFromName(name);
     if (!rung) throw InputError("pair." + field->name() + ": unknown rung '" + name + "'");
     return *rung;
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return reflection->GetString(in, field);
   } else if constexpr (std::is_same_v<T, int>) {
     const uint32_t value = reflection->GetUInt32(in, field);
     return static_cast<int>(std::min<uint32_t>(value, std::numeric_limits<int>::max()));

@@ -83,6 +83,7 @@ MapBuildSettings MapBuildFromSettings(const RequestedSettings& settings) {
   if (!std::isfinite(map.cloud_voxel) || map.cloud_voxel < 0.0) {
     throw InputError("map settings: cloud_voxel must be >= 0 (0 = resolution)");
   }
+  map.loops = LoopSearchFromName(settings.loops, "loops");
   return map;
 }
 

@@ -151,6 +151,10 @@ std::vector<SettingField> BuildSchema() {
       {"cloud_voxel", "--cloud-voxel", nullptr, "cloud_voxel", kMapMsg, "cloud_voxel", kSubmit,
        "Voxel of the exported merged PLY (metres); default: the resolution", kNoMergedCloudLocally,
        OptionalBinding<double>{&RS::cloud_voxel}, kCells},
+      {"loops", "--loops", nullptr, "loops", kMapMsg, "loops", kMapFrontEnds,
+       "auto (look for loop closures on the chained poses and keep those registration trusts) "
+       "or off (only the pairing's pairs)",
+       kNoMapInRegister, PlainBinding<std::string>{&RS::loops}, kUnbounded},
   };
 }
 

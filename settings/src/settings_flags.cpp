@@ -19,6 +19,7 @@ void CheckWords(const RequestedSettings& settings, Frontend frontend) {
     alone.*binding->requested = settings.*binding->requested;
     try {
       ConfigFromSettings(alone);
+      MapBuildFromSettings(alone);
     } catch (const InputError& e) {
       throw InputError(std::string(FlagFor(field, frontend)) + ": " + e.what());
     }

@@ -10,7 +10,8 @@ namespace boicp {
 
 PairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairIndex& pair,
                              const BoIcpConfig& job_config, PreparedScanCache& prepared,
-                             const std::function<bool()>& stop_requested) {
+                             const std::function<bool()>& stop_requested,
+                             const std::optional<Transform>& prior) {
   const std::shared_ptr<const PreparedScan> source = prepared.Get(pair.source);
   const std::shared_ptr<const PreparedScan> target = prepared.Get(pair.target);
 
@@ -19,8 +20,9 @@ PairResult RegisterBatchPair(const std::vector<ScanSource>& scans, const PairInd
   RegistrationCallbacks callbacks;
   callbacks.stop_requested = stop_requested;
   PairHints hints;
-  hints.prior =
-      PairPrior(scans[static_cast<size_t>(pair.source)], scans[static_cast<size_t>(pair.target)]);
+  hints.prior = prior ? prior
+                      : PairPrior(scans[static_cast<size_t>(pair.source)],
+                                  scans[static_cast<size_t>(pair.target)]);
   // Scans next to each other in a batch are usually a drive's consecutive
   // scans, which ICP from identity aligns: the ladder's prior rung tries it.
   if (std::abs(pair.source - pair.target) == 1) hints.guess = Transform::Identity();
@@ -71,6 +73,7 @@ std::string DoubtfulSummary(int doubtful, int total) {
 PoseGraphOptions BatchPoseGraphOptions(const BoIcpConfig& job_config) {
   PoseGraphOptions options;
   options.max_correspondence_distance = job_config.EffectiveInlierDistance();
+  options.pair_error = kPairErrorOfInlierDistance * options.max_correspondence_distance;
   return options;
 }
 

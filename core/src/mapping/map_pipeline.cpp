@@ -1,6 +1,7 @@
 #include "boicp/mapping/map_pipeline.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
 #include <utility>
 
@@ -11,6 +12,62 @@ namespace {
 
 std::pair<int, int> Unordered(const PairIndex& p) {
   return {std::min(p.source, p.target), std::max(p.source, p.target)};
+}
+
+// Where each scan looks, in the map frame: its points' centroid moved by
+// its pose (its sensor origin when it has no points).
+std::vector<Point> ViewCentres(const std::vector<ScanSource>& scans,
+                               const std::vector<Transform>& poses) {
+  std::vector<Point> centres;
+  centres.reserve(scans.size());
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const Points points = LoadPointCloud(scans[i].path, scans[i].load).points;
+    Point centroid = scans[i].sensor_origin;
+    if (!points.empty()) {
+      centroid = Point::Zero();
+      for (const Point& p : points) centroid += p;
+      centroid /= static_cast<double>(points.size());
+    }
+    centres.push_back(poses[i].topLeftCorner<3, 3>() * centroid + poses[i].topRightCorner<3, 1>());
+  }
+  return centres;
+}
+
+// The loop stage's progress: only the pairs it registers are new.
+class LoopStageProgress : public MapProgressSink {
+ public:
+  explicit LoopStageProgress(MapProgressSink& inner) : inner_(inner) {}
+  void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
+    if (!reused) inner_.PairFinished(pair, reused, counts);
+  }
+  void PairFailed(const PairIndex& pair, const std::string& message) override {
+    inner_.PairFailed(pair, message);
+  }
+  void Heartbeat() override { inner_.Heartbeat(); }
+
+ private:
+  MapProgressSink& inner_;
+};
+
+bool IsTrustedLoop(const PairResult& result) { return result.confidence >= kLoopTrustedFrom; }
+
+// Why each edge the poses do not use, and each loop candidate that was no
+// edge, was left out.
+std::map<PairIndex, std::string> LeftOut(const GraphEdges& edges, const RegisteredPairs& registered,
+                                         const PoseEstimate& estimate) {
+  std::map<PairIndex, std::string> left_out;
+  for (const PairIndex& p : registered.loops) {
+    const double confidence = registered.finished.at(p).confidence;
+    if (confidence >= kLoopTrustedFrom) continue;
+    char reason[96];
+    std::snprintf(reason, sizeof(reason), "not trusted as a loop (confidence %.3f < %.2f)",
+                  confidence, kLoopTrustedFrom);
+    left_out[p] = reason;
+  }
+  for (size_t i = 0; i < edges.pairs.size(); ++i) {
+    if (!estimate.kept.at(i)) left_out[edges.pairs[i]] = estimate.left_out_because.at(i);
+  }
+  return left_out;
 }
 
 }  // namespace
@@ -30,7 +87,65 @@ GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& regi
   for (const PairIndex& p : plan.extras) {
     if (in_chain.count(Unordered(p)) == 0) add(p);
   }
+  for (const PairIndex& p : registered.loops) {
+    if (IsTrustedLoop(registered.finished.at(p))) add(p);
+  }
   return edges;
+}
+
+void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
+                            MapProgressSink& progress, const PairExecution& execution) {
+  const PoseEstimate chained =
+      EstimatePoses(batch.scans, GraphConstraints(batch.plan, registered).constraints,
+                    BatchPoseGraphOptions(batch.config));
+  LoopCandidateOptions options;
+  options.reach = batch.config.translation_bounds.maxCoeff();
+  std::set<std::pair<int, int>> registered_already;
+  for (const auto& entry : registered.finished) registered_already.insert(Unordered(entry.first));
+
+  PairingPlan plan = PlanFixedPairs(registered.chain, batch.plan.extras);
+  std::vector<PairIndex> loops;
+  for (const LoopCandidate& c :
+       LoopCandidatesFromPoses(chained.poses, ViewCentres(batch.scans, chained.poses), options)) {
+    if (registered_already.count(Unordered(c.pair)) != 0) continue;
+    plan.extras.push_back(c.pair);
+    plan.loop_priors[c.pair] = c.prior;
+    loops.push_back(c.pair);
+  }
+  if (loops.empty()) return;
+  LoopStageProgress loop_progress(progress);
+  RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan, store,
+                                               loop_progress, execution);
+  for (const PairIndex& p : loops) registered.finished[p] = std::move(found.finished.at(p));
+  registered.loops = std::move(loops);
+}
+
+LoopStageSummary SummariseLoops(const RegisteredPairs& registered,
+                                const std::vector<PairIndex>& in_graph) {
+  const std::set<PairIndex> used(in_graph.begin(), in_graph.end());
+  const std::set<PairIndex> loops(registered.loops.begin(), registered.loops.end());
+  LoopStageSummary summary;
+  summary.candidates = static_cast<int>(loops.size());
+  for (const auto& [pair, result] : registered.finished) {
+    if (loops.count(pair) == 0) {
+      summary.other_seconds += result.runtime_s;
+      continue;
+    }
+    summary.seconds += result.runtime_s;
+    summary.closed += used.count(pair) != 0;
+  }
+  return summary;
+}
+
+std::string LoopStageSummary::Line() const {
+  if (candidates == 0) return "";
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "%d loops closed of %d candidates; verifying them took %.0f s, %.0f %% of the "
+                "other pairs' %.0f s",
+                closed, candidates, seconds,
+                other_seconds > 0.0 ? 100.0 * seconds / other_seconds : 0.0, other_seconds);
+  return line;
 }
 
 std::vector<PairIndex> PairsInGraph(const GraphEdges& edges, const PoseEstimate& estimate) {
@@ -52,6 +167,7 @@ AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registere
   assembled.estimate =
       EstimatePoses(batch.scans, edges.constraints, BatchPoseGraphOptions(batch.config));
   assembled.in_graph = PairsInGraph(edges, assembled.estimate);
+  assembled.left_out = LeftOut(edges, registered, assembled.estimate);
   store.MarkInGraph(assembled.in_graph);
   progress.PosesEstimated(assembled.estimate, assembled.in_graph);
 
@@ -71,6 +187,9 @@ MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapPro
   MapPipelineResult result;
   result.pairs = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, batch.plan, store,
                                       progress, execution);
+  if (batch.map.loops == LoopSearch::kAuto) {
+    RegisterLoopCandidates(batch, result.pairs, store, progress, execution);
+  }
   result.map =
       AssembleMap(batch, result.pairs, store, progress, outputs, execution.stop_requested, hooks);
   return result;

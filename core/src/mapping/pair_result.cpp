@@ -51,6 +51,10 @@ const std::vector<PairResultField>& PairResultFields() {
       {"information", &PairResult::information, kPairFile},
       // A pair file is written as its pair finishes, before the graph is known.
       {"in_graph", &PairResult::in_graph, kPairListing | kPairApi},
+      // The plan says why each pair ran, when the pipeline lists it.
+      {"kind", &PairResult::kind, kPairListing | kPairApi},
+      {"found_by", &PairResult::found_by, kPairListing | kPairApi},
+      {"left_out_because", &PairResult::left_out_because, kPairListing},
       {"finished_at", &PairResult::finished_at, kPairApi},
   };
   return kFields;

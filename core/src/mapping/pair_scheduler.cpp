@@ -53,6 +53,15 @@ bool PlanUses(const PairingPlan& plan, const PairIndex& pair) {
   return plan.keyframes ? pair.source > pair.target : listed(plan.chain);
 }
 
+// Why `result`'s pair ran, as the plan says (PairResult::kind).
+void MarkKind(const PairingPlan& plan, PairResult& result) {
+  const bool extra =
+      std::find(plan.extras.begin(), plan.extras.end(), result.pair) != plan.extras.end();
+  const bool loop = plan.loop_priors.count(result.pair) != 0;
+  result.kind = loop ? "loop" : extra ? "extra" : "chain";
+  result.found_by = loop ? "poses" : "";
+}
+
 // The batch's settings at each scale step its pairs use, with each scan
 // prepared at them: the pairs of one step share their scans' preparation.
 class ScaledPreparation {
@@ -137,7 +146,9 @@ class PairScheduler {
       for (size_t i = 0; i < fixed.size(); ++i) listing_order_[fixed[i]] = static_cast<int>(i);
     }
     for (PairResult& stored : store_.LoadFinished()) {
-      if (PlanUses(plan_, stored.pair)) finished_[stored.pair] = std::move(stored);
+      if (!PlanUses(plan_, stored.pair)) continue;
+      MarkKind(plan_, stored);
+      finished_[stored.pair] = std::move(stored);
     }
     if (plan_.keyframes) {
       planner_.emplace(num_scans_, plan_.overlap_threshold);
@@ -288,7 +299,12 @@ class PairScheduler {
     } else {
       try {
         ScaledPreparation::Level& level = preparation_.For(pair);
-        PairResult result = RegisterBatchPair(scans_, pair, level.config, *level.prepared, stop);
+        const auto loop_prior = plan_.loop_priors.find(pair);
+        PairResult result = RegisterBatchPair(scans_, pair, level.config, *level.prepared, stop,
+                                              loop_prior != plan_.loop_priors.end()
+                                                  ? std::optional<Transform>(loop_prior->second)
+                                                  : std::nullopt);
+        MarkKind(plan_, result);
         store_.Save(order, result);
         completion.finished = std::move(result);
       } catch (const Cancelled&) {

@@ -49,6 +49,9 @@ struct PairingPlan {
   double overlap_threshold = 0.7;  // keyframes only, in (0, 1]
   std::vector<PairIndex> chain;    // fixed plans: chained first into poses
   std::vector<PairIndex> extras;   // loop closures on top of the chain
+  /// Extras that are loop candidates found on the chained poses, each with
+  /// the chain's T_target_source: their searches are centred there.
+  std::map<PairIndex, Transform> loop_priors;
 };
 
 /// A fixed plan: `chain` (consecutive or explicit pairs) plus `extras`.

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <variant>
 #include <vector>
 
@@ -43,6 +44,16 @@ struct PairResult {
   InformationMatrix information = InformationMatrix::Identity();
   /// False for a keyframe probe or loop closure the final poses leave out.
   bool in_graph = true;
+  /// Why the pair was registered: "chain" (the plan's own pairs, keyframe
+  /// probes included), "extra" (listed by the user) or "loop" (a loop
+  /// candidate the map found itself).
+  std::string kind = "chain";
+  /// For a loop: how its candidate was found, "poses" (its scans' views lie
+  /// within reach under the chained poses); empty for the other kinds.
+  std::string found_by;
+  /// Why the final poses leave the pair out; empty when in_graph (and for
+  /// keyframe probes the chain did not need).
+  std::string left_out_because;
   double finished_at = 0.0;  // Unix seconds; 0 when not recorded
 };
 
@@ -69,7 +80,7 @@ enum PairResultFormat : unsigned {
 using PairResultMember =
     std::variant<Transform PairResult::*, InformationMatrix PairResult::*, double PairResult::*,
                  std::optional<double> PairResult::*, bool PairResult::*, Rung PairResult::*,
-                 int PairResult::*, uint64_t PairResult::*>;
+                 int PairResult::*, uint64_t PairResult::*, std::string PairResult::*>;
 
 struct PairResultField {
   const char* name;  // the JSON key, and the boicp.v1.PairResult field
