@@ -74,12 +74,12 @@ if "trajectory" in off:
 else:
     (ok_off, n), (ok_auto, _) = revisits(off), revisits(auto)
     cells = [f"revisits {ok_off}/{n}", f"revisits {ok_auto}/{n}", "-"]
-share = summary["loop_seconds"] / summary["other_pair_seconds"] if summary["other_pair_seconds"] else 0
+share = summary["loop_runtime_s"] / summary["other_pairs_runtime_s"] if summary["other_pairs_runtime_s"] else 0
 peak = next((int(l.split(":")[1]) // 1024 for l in open(f"{base}/auto.log")
              if "Maximum resident set size" in l), 0)
 print(f"| {name} | {summary['scans']} | " + " | ".join(cells) +
       f" | {summary['loops_closed']} / {summary['loop_candidates']} | "
-      f"{summary['loop_seconds']:.0f} / {summary['other_pair_seconds']:.0f} s ({100 * share:.0f} %)"
+      f"{summary['loop_runtime_s']:.0f} / {summary['other_pairs_runtime_s']:.0f} s ({100 * share:.0f} %)"
       f" | {wrong} | {peak} |")
 PY
 done

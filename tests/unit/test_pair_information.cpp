@@ -97,13 +97,14 @@ TEST(PlaneInformation, AWallLeavesItsOwnDirectionsFree) {
   // Three directions of 6 are free: two slides and the turn about x.
   EXPECT_NEAR(spectrum.eigenvalues()(2), 0.0, 1e-6 * spectrum.eigenvalues()(5));
 
-  // A street's scan constrains every direction.
+  // A street's scan constrains every direction (its rotation block, in m^2,
+  // is hundreds of times its translation block: hence the small ratio).
   const Points street = SimulateScan(MakeSyntheticStreet(3, 10.0),
                                      PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8}), 20.0, 0.0, 1);
   const InformationMatrix street_info =
       PlaneInformation(street, NearestNeighborIndex(street), Transform::Identity(), 0.3, 1.0);
   const Eigen::SelfAdjointEigenSolver<InformationMatrix> street_spectrum(street_info);
-  EXPECT_GT(street_spectrum.eigenvalues()(0), 1e-3 * street_spectrum.eigenvalues()(5));
+  EXPECT_GT(street_spectrum.eigenvalues()(0), 1e-4 * street_spectrum.eigenvalues()(5));
 }
 
 }  // namespace
