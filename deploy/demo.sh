@@ -25,7 +25,9 @@ while [ $# -gt 0 ]; do
 done
 
 bash deploy/install-deps.sh
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBOICP_BUILD_TESTS=OFF
+# Unity batches, as .ci/run and the Dockerfile build: each parses the heavy
+# headers once.
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBOICP_BUILD_TESTS=OFF -DCMAKE_UNITY_BUILD=ON
 cmake --build "$build" -j"$(nproc)" --target boicp_apps
 boicp="$build/bin/boicp"
 # The Python package, where Debian's python3 finds it: `python3 -c "import boicp"`.
