@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job on a fresh machine: install dependencies, build everything,
-# install the Python package, start boicpd on a free loopback port with its
+# The main job on a fresh machine: install dependencies, build what it runs
+# (boicp, boicpd and the Python package; no tests, no benchmarks: .ci/run builds
+# and runs those), install the Python package, start boicpd on a free loopback port with its
 # data directory under build/, submit a logged drive with the boicp client (a generated 8-scan drive, or
 # the scans of --data DIR), follow its progress, export the map, trajectory
 # and preview, and stop the daemon.
@@ -24,8 +25,10 @@ while [ $# -gt 0 ]; do
 done
 
 bash deploy/install-deps.sh
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
-cmake --build "$build" -j"$(nproc)"
+# Unity batches, as .ci/run and the Dockerfile build: each parses the heavy
+# headers once.
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DBOICP_BUILD_TESTS=OFF -DCMAKE_UNITY_BUILD=ON
+cmake --build "$build" -j"$(nproc)" --target boicp_apps
 boicp="$build/bin/boicp"
 # The Python package, where Debian's python3 finds it: `python3 -c "import boicp"`.
 if [ -f "$build/python/boicp/__init__.py" ]; then

@@ -19,7 +19,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy
   python3-dev pybind11-dev python3-pytest python3-grpcio python3-protobuf
-  clang-format yamllint systemd clang libclang-rt-14-dev
+  clang-format yamllint systemd clang libclang-rt-14-dev ccache
 )
 
 # The shared libraries boicpd and boicp link directly (objdump -p NEEDED, then

@@ -99,6 +99,5 @@ set(_boicp_python_test_environment "PYTHONPATH=${_boicp_python_root}"
 set_tests_properties(python_client PROPERTIES
   ENVIRONMENT "${_boicp_python_test_environment}"
   LABELS python
-  RUN_SERIAL TRUE
   TIMEOUT 300
   SKIP_REGULAR_EXPRESSION "\n[0-9]+ skipped in ")
