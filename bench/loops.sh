@@ -51,6 +51,7 @@ report="$out/loops.md"
 } >"$report"
 for entry in "${drives[@]}"; do
   IFS='|' read -r name folder reference <<<"$entry"
+  mkdir -p "$out/$name"
   for loops in off auto; do
     run="$out/$name/$loops"
     /usr/bin/time -v "$boicp" map "$folder" -o "$run" --loops "$loops" --json \
