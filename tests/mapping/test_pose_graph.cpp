@@ -96,7 +96,7 @@ double MaxTranslationError(const std::vector<Transform>& poses,
 }
 
 // The circle's odometry chain 0->1->...->7 plus the loop closure 7->0. The
-// information is shaped like PairInformation's: rotation weighs the square
+// information is shaped like PlaneInformation's: rotation weighs the square
 // of the points' spread (here 10 m) times the translation's.
 std::vector<PairConstraint> CircleWithLoop(const std::vector<Transform>& truth) {
   InformationMatrix information = InformationMatrix::Identity();
@@ -206,7 +206,7 @@ std::vector<Transform> Laps(int laps, int per_lap) {
   return poses;
 }
 
-// Information shaped as PairInformation gives it: 5000 inliers spread 2 m
+// Information shaped as PlaneInformation gives it: 5000 inliers spread 2 m
 // about the target's origin.
 InformationMatrix FiveThousandInliers() {
   InformationMatrix information = InformationMatrix::Identity() * 5000.0;

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "boicp/icp/pair_information.hpp"
+#include "boicp/icp/surface_normals.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/registration/refinement.hpp"
@@ -14,30 +15,30 @@
 namespace boicp {
 namespace {
 
-TEST(PairInformation, IsTheMatchedPointsInertiaAndVanishesWithoutOverlap) {
+TEST(PlaneInformation, SumsEachMatchAlongItsNormalAndVanishesWithoutOverlap) {
   const Points world = MakeSyntheticStreet(3, 10.0);
   const Points scan =
       SimulateScan(world, PoseFromYawTranslation(0.0, Eigen::Vector3d::Zero()), 20.0, 0.0, 1);
   const NearestNeighborIndex index(scan);
-  const InformationMatrix info = PairInformation(scan, index, Transform::Identity(), 0.3);
-  // Every point matches itself: the translation block counts the matches, and
-  // the rotation block is the points' inertia tensor, sum |q|^2 I - q q^T.
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
-  for (const Point& q : scan)
-    inertia += q.squaredNorm() * Eigen::Matrix3d::Identity() - q * q.transpose();
-  const Eigen::Matrix3d rotation_block = info.topLeftCorner(3, 3);
-  const Eigen::Matrix3d translation_block = info.bottomRightCorner(3, 3);
-  const double matches = static_cast<double>(scan.size());
-  EXPECT_TRUE(translation_block.isApprox(matches * Eigen::Matrix3d::Identity(), 1e-12));
-  EXPECT_TRUE(rotation_block.isApprox(inertia, 1e-9));
+  const InformationMatrix info = PlaneInformation(scan, index, Transform::Identity(), 0.3, 1.0);
+  // Every point matches itself: each adds J^T J with J = (q x n, n).
+  InformationMatrix expected = InformationMatrix::Zero();
+  for (const Point& q : scan) {
+    const Point n = SurfaceNormalAt(index, q, 1.0);
+    Eigen::Matrix<double, 6, 1> jacobian;
+    jacobian << q.cross(n), n;
+    expected += jacobian * jacobian.transpose();
+  }
+  EXPECT_TRUE(info.isApprox(expected, 1e-9));
+  EXPECT_GT(info.bottomRightCorner(3, 3).trace(), 0.5 * static_cast<double>(scan.size()));
   const InformationMatrix none =
-      PairInformation(scan, index, PoseFromYawTranslation(0.0, {0.0, 100.0, 0.0}), 0.3);
+      PlaneInformation(scan, index, PoseFromYawTranslation(0.0, {0.0, 100.0, 0.0}), 0.3, 1.0);
   EXPECT_TRUE(none.isZero());
 }
 
 // RegisterPair measures the information on centred clouds; moved back to
 // the scans' frames it is what the scans' own points give.
-TEST(PairInformation, MovedInformationIsThatOfTheMovedTargetPoints) {
+TEST(PlaneInformation, MovedInformationIsThatOfTheMovedTargetPoints) {
   const Points world = MakeSyntheticStreet(3, 10.0);
   const Transform T = PoseFromYawTranslation(0.1, {0.5, -0.2, 0.0});
   const Points target = SimulateScan(world, Transform::Identity(), 20.0, 0.0, 1);
@@ -45,17 +46,18 @@ TEST(PairInformation, MovedInformationIsThatOfTheMovedTargetPoints) {
   const Point offset(1200.0, -800.0, 35.0);
   Transform moved_T = T;
   moved_T.topRightCorner<3, 1>() += offset;
-  const InformationMatrix expected = PairInformation(
-      source, NearestNeighborIndex(TransformPoints(moved_T * T.inverse(), target)), moved_T, 0.3);
+  const InformationMatrix expected =
+      PlaneInformation(source, NearestNeighborIndex(TransformPoints(moved_T * T.inverse(), target)),
+                       moved_T, 0.3, 1.0);
   const InformationMatrix moved =
-      MovedInformation(PairInformation(source, NearestNeighborIndex(target), T, 0.3), offset);
-  EXPECT_GT(expected(3, 3), 1000.0);
-  EXPECT_TRUE(moved.isApprox(expected, 1e-9)) << moved << "\n\n" << expected;
+      MovedInformation(PlaneInformation(source, NearestNeighborIndex(target), T, 0.3, 1.0), offset);
+  EXPECT_GT(expected(3, 3), 100.0);
+  EXPECT_TRUE(moved.isApprox(expected, 1e-6)) << moved << "\n\n" << expected;
 }
 
 // The answer's information counts the finest level's inliers, the same
 // points its fitness is the share of.
-TEST(PairInformation, RegisterPairReportsItForTheFinestLevelInliers) {
+TEST(PlaneInformation, RegisterPairReportsItForTheFinestLevelInliers) {
   const Points world = MakeSyntheticStreet(11, 15.0);
   const Transform T_world_target = PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8});
   const Transform T_world_source = PoseFromYawTranslation(0.4, {1.2, 0.4, 1.8});

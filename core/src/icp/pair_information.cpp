@@ -4,24 +4,6 @@
 
 namespace boicp {
 
-InformationMatrix PairInformation(const Points& source, const NearestNeighborIndex& target,
-                                  const Transform& T_target_source, double max_distance) {
-  InformationMatrix information = InformationMatrix::Zero();
-  const double max_squared = max_distance * max_distance;
-  for (const Point& p : TransformPoints(T_target_source, source)) {
-    size_t match = 0;
-    double squared = 0.0;
-    if (!target.Nearest(p, max_squared, match, squared)) continue;
-    const Point& q = target.points()[match];
-    Eigen::Matrix<double, 3, 6> jacobian;
-    jacobian << 0.0, q.z(), -q.y(), 1.0, 0.0, 0.0,  //
-        -q.z(), 0.0, q.x(), 0.0, 1.0, 0.0,          //
-        q.y(), -q.x(), 0.0, 0.0, 0.0, 1.0;
-    information += jacobian.transpose() * jacobian;
-  }
-  return information;
-}
-
 InformationMatrix PlaneInformation(const Points& source, const NearestNeighborIndex& target,
                                    const Transform& T_target_source, double max_distance,
                                    double normal_radius) {

@@ -1,6 +1,5 @@
 #include "boicp/mapping/chain_uncertainty.hpp"
 
-#include <deque>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -65,30 +64,16 @@ ChainUncertainty::ChainUncertainty(const std::vector<Transform>& poses,
       parent_(poses.size(), -1),
       depth_(poses.size(), -1),
       step_(poses.size(), PoseCovariance::Zero()) {
-  std::vector<std::vector<size_t>> edges_of(poses.size());
-  for (size_t e = 0; e < constraints.size() && e < in_tree.size(); ++e) {
-    if (!in_tree[e]) continue;
-    edges_of[static_cast<size_t>(constraints[e].pair.source)].push_back(e);
-    edges_of[static_cast<size_t>(constraints[e].pair.target)].push_back(e);
-  }
   if (poses.empty()) return;
   depth_[0] = 0;
-  std::deque<int> queue{0};
-  while (!queue.empty()) {
-    const int at = queue.front();
-    queue.pop_front();
-    for (size_t e : edges_of[static_cast<size_t>(at)]) {
-      const PairConstraint& c = constraints[e];
-      const int next = c.pair.target == at ? c.pair.source : c.pair.target;
-      const auto n = static_cast<size_t>(next);
-      if (depth_[n] >= 0) continue;
-      parent_[n] = at;
-      depth_[n] = depth_[static_cast<size_t>(at)] + 1;
-      // The edge measures T_target_source, perturbed on the right.
-      const PoseCovariance edge = CovarianceOf(c.information);
-      step_[n] = c.pair.target == at ? edge : OfInverse(c.T_target_source, edge);
-      queue.push_back(next);
-    }
+  for (const TreeStep& step : WalkTree(static_cast<int>(poses.size()), constraints, in_tree)) {
+    const PairConstraint& c = constraints[step.edge];
+    const auto n = static_cast<size_t>(step.scan);
+    parent_[n] = step.from;
+    depth_[n] = depth_[static_cast<size_t>(step.from)] + 1;
+    // The edge measures T_target_source, perturbed on the right.
+    const PoseCovariance edge = CovarianceOf(c.information);
+    step_[n] = c.pair.target == step.from ? edge : OfInverse(c.T_target_source, edge);
   }
   for (size_t i = 0; i < poses.size(); ++i) {
     if (depth_[i] < 0) {

@@ -199,7 +199,6 @@ ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constr
   // the first constraint joining two parts wins.
   std::vector<int> parent(static_cast<size_t>(num_scans));
   std::iota(parent.begin(), parent.end(), 0);
-  std::vector<std::vector<size_t>> edges_of(static_cast<size_t>(num_scans));
   for (const bool doubtful_pass : {false, true}) {
     for (size_t e = 0; e < constraints.size(); ++e) {
       if (IsDoubtfulEdge(constraints[e]) != doubtful_pass) continue;
@@ -211,35 +210,23 @@ ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constr
       }
       parent[a] = b;
       out.in_tree[e] = true;
-      edges_of[static_cast<size_t>(p.source)].push_back(e);
-      edges_of[static_cast<size_t>(p.target)].push_back(e);
     }
   }
 
-  // Breadth-first from scan 0 along tree edges, in whichever direction the
-  // edge points.
-  std::vector<bool> placed(static_cast<size_t>(num_scans), false);
   out.poses.assign(static_cast<size_t>(num_scans), Transform::Identity());
   out.poses[0] = anchor;
+  const std::vector<TreeStep> walk = WalkTree(num_scans, constraints, out.in_tree);
+  std::vector<bool> placed(static_cast<size_t>(num_scans), false);
   placed[0] = true;
-  std::deque<int> queue{0};
-  while (!queue.empty()) {
-    const int at = queue.front();
-    queue.pop_front();
-    for (size_t e : edges_of[static_cast<size_t>(at)]) {
-      const PairConstraint& c = constraints[e];
-      const bool at_is_target = c.pair.target == at;
-      const int next = at_is_target ? c.pair.source : c.pair.target;
-      if (placed[static_cast<size_t>(next)]) continue;
-      // T_map_source = T_map_target * T_target_source, and its inverse for
-      // walking from the source to the target.
-      out.poses[static_cast<size_t>(next)] =
-          at_is_target
-              ? Transform(out.poses[static_cast<size_t>(at)] * c.T_target_source)
-              : Transform(out.poses[static_cast<size_t>(at)] * c.T_target_source.inverse());
-      placed[static_cast<size_t>(next)] = true;
-      queue.push_back(next);
-    }
+  for (const TreeStep& step : walk) {
+    const PairConstraint& c = constraints[step.edge];
+    // T_map_source = T_map_target * T_target_source, and its inverse for
+    // walking from the source to the target.
+    const Transform& from = out.poses[static_cast<size_t>(step.from)];
+    out.poses[static_cast<size_t>(step.scan)] = c.pair.target == step.from
+                                                    ? Transform(from * c.T_target_source)
+                                                    : Transform(from * c.T_target_source.inverse());
+    placed[static_cast<size_t>(step.scan)] = true;
   }
   for (int i = 0; i < num_scans; ++i) {
     if (!placed[static_cast<size_t>(i)]) {
@@ -248,6 +235,34 @@ ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constr
     }
   }
   return out;
+}
+
+std::vector<TreeStep> WalkTree(int num_scans, const std::vector<PairConstraint>& constraints,
+                               const std::vector<bool>& in_tree) {
+  std::vector<std::vector<size_t>> edges_of(static_cast<size_t>(std::max(num_scans, 0)));
+  for (size_t e = 0; e < constraints.size() && e < in_tree.size(); ++e) {
+    if (!in_tree[e]) continue;
+    edges_of[static_cast<size_t>(constraints[e].pair.source)].push_back(e);
+    edges_of[static_cast<size_t>(constraints[e].pair.target)].push_back(e);
+  }
+  std::vector<TreeStep> walk;
+  if (num_scans < 1) return walk;
+  std::vector<bool> reached(static_cast<size_t>(num_scans), false);
+  reached[0] = true;
+  std::deque<int> queue{0};
+  while (!queue.empty()) {
+    const int at = queue.front();
+    queue.pop_front();
+    for (size_t e : edges_of[static_cast<size_t>(at)]) {
+      const PairIndex& p = constraints[e].pair;
+      const int next = p.target == at ? p.source : p.target;
+      if (reached[static_cast<size_t>(next)]) continue;
+      reached[static_cast<size_t>(next)] = true;
+      walk.push_back({next, at, e});
+      queue.push_back(next);
+    }
+  }
+  return walk;
 }
 
 OptimizedPoses OptimizePoseGraph(const std::vector<Transform>& initial,

@@ -21,7 +21,7 @@ struct PairConstraint {
   PairIndex pair;
   Transform T_target_source = Transform::Identity();
   /// Weight of the edge in the optimisation; Open3D's convention (rotation
-  /// first, then translation), as PairInformation computes it.
+  /// first, then translation), as PlaneInformation computes it.
   InformationMatrix information = InformationMatrix::Identity();
   /// The pair's estimated probability of being right, in [0, 1]
   /// (RegistrationResult::confidence); 1 = fully trusted.
@@ -50,6 +50,21 @@ struct ChainedPoses {
 ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constraints,
                         const Transform& anchor = Transform::Identity());
 
+/// One step of a walk along a spanning tree: `scan` reached from `from`
+/// over constraint `edge`.
+struct TreeStep {
+  int scan = 0;
+  int from = 0;
+  size_t edge = 0;
+};
+
+/// The tree edges (in_tree) of `constraints` walked breadth-first from scan
+/// 0, whichever way each edge points: every scan reached but scan 0, each
+/// after the scan it is reached from. Precondition: every index of the
+/// constraints is within [0, num_scans).
+std::vector<TreeStep> WalkTree(int num_scans, const std::vector<PairConstraint>& constraints,
+                               const std::vector<bool>& in_tree);
+
 struct PoseGraphOptions {
   /// Metres; the distance the edges' information matrices were computed
   /// with. Open3D derives the line-process weight of loop closures from it.
@@ -72,8 +87,8 @@ struct PoseGraphOptions {
 };
 
 /// The information of a pair whose translation errs by `pair_error` metres
-/// along each axis: `information` (a sum over the inliers, PairInformation
-/// or PlaneInformation) divided by a third of its translation block's trace
+/// along each axis: `information` (a sum over the inliers, as
+/// PlaneInformation gives it) divided by a third of its translation block's trace
 /// (the inlier count) and by pair_error^2, plus kMinEdgeWeight /
 /// pair_error^2 on the diagonal. Its rotation part keeps the inliers'
 /// spread, and a direction they do not constrain stays weak.
