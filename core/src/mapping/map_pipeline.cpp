@@ -57,11 +57,11 @@ std::map<PairIndex, std::string> LeftOut(const GraphEdges& edges, const Register
                                          const PoseEstimate& estimate) {
   std::map<PairIndex, std::string> left_out;
   for (const PairIndex& p : registered.loops) {
-    const double confidence = registered.finished.at(p).confidence;
-    if (confidence >= kLoopTrustedFrom) continue;
+    const PairResult& loop = registered.finished.at(p);
+    if (IsTrustedLoop(loop)) continue;
     char reason[96];
     std::snprintf(reason, sizeof(reason), "not trusted as a loop (confidence %.3f < %.2f)",
-                  confidence, kLoopTrustedFrom);
+                  loop.confidence, kLoopTrustedFrom);
     left_out[p] = reason;
   }
   for (size_t i = 0; i < edges.pairs.size(); ++i) {
