@@ -13,7 +13,6 @@
 #include <map>
 #include <sstream>
 
-#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "boicp/io/scan_folder.hpp"
@@ -116,8 +115,6 @@ std::vector<std::optional<Transform>> ReferencePoses(const WrittenMap& map,
   return poses;
 }
 
-double RotationDeg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
-
 // Each pair's error against the reference, and per kind: count, wrong, and
 // wrong among the trusted.
 json PairErrors(const WrittenMap& map, const std::vector<std::optional<Transform>>& reference,
@@ -133,8 +130,8 @@ json PairErrors(const WrittenMap& map, const std::vector<std::optional<Transform
     }
     const Transform truth = reference[t]->inverse() * *reference[s];
     const Transform error = truth.inverse() * estimated;
-    const double rotation = RotationDeg(error.topLeftCorner<3, 3>());
-    const double translation = error.topRightCorner<3, 1>().norm();
+    const double rotation = RotationAngle(error) * 180.0 / M_PI;
+    const double translation = TranslationNorm(error);
     const bool wrong = rotation > max_rotation_deg || translation > max_translation;
     const bool doubtful = pair.value("doubtful", false);
     const std::string kind = pair.value("kind", "chain");
