@@ -7,12 +7,14 @@ OUT holds one boicp-bench run per field condition (bench/field.sh), in
 OUT/<condition>/results.csv; OUT/clean is the suite as it is. For every
 condition, dataset and method: the successes, the share of the clean run's
 successes that remain, and how many misses the confidence called doubtful
-(below 0.5), which is what a user can act on.
+(below 0.95, kTrustedFrom), which is what a user can act on.
 """
 
 import csv
 import os
 import sys
+
+TRUSTED_FROM = 0.95  # kTrustedFrom in core/include/boicp/registration/bo_icp.hpp
 
 CONDITIONS = ["clean", "sector", "quarter", "far-returns", "tilt", "far-origin", "geo-origin"]
 
@@ -29,7 +31,7 @@ def tally(rows):
         key = (row["dataset"], row["method"])
         pairs, wins, misses, flagged_misses, flagged_wins = out.get(key, (0, 0, 0, 0, 0))
         success = row["success"] == "1"
-        doubtful = row["confidence"] != "" and float(row["confidence"]) < 0.5
+        doubtful = row["confidence"] != "" and float(row["confidence"]) < TRUSTED_FROM
         out[key] = (pairs + 1, wins + success, misses + (not success),
                     flagged_misses + (not success and doubtful),
                     flagged_wins + (success and doubtful))

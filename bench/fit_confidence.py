@@ -13,7 +13,7 @@ ridge penalty on the --fit rows, and capped as the engine caps it (low
 fitness, a near tie with a measured runner-up, points the target saw
 through). It prints the weights as C++ constants,
 then for the --test rows (never used in the fit): the AUROC, the share of
-failures flagged doubtful (confidence < 0.5), the share of successes
+failures flagged doubtful (confidence < 0.95), the share of successes
 flagged, and a reliability table. --check reports the same for the
 confidence the engine itself recorded in the rows (the shipped model, final
 answers after any retry), with no fit. --folds fits leave-one-dataset-out:
@@ -29,6 +29,8 @@ import math
 import sys
 
 import numpy as np
+
+TRUSTED_FROM = 0.95  # kTrustedFrom in core/include/boicp/registration/bo_icp.hpp
 
 # The results.csv also carries rmse_ratio, support and probability_better.
 # They separated held-out runs no better, and the weights they took (support
@@ -129,8 +131,8 @@ def report(p, y_test):
     failures, successes = y_test == 0, y_test == 1
     print(f"AUROC {auroc(p, y_test):.3f}")
     if failures.any():
-        print(f"failures flagged doubtful: {int((p[failures] < 0.5).sum())}/{int(failures.sum())}")
-    print(f"successes flagged doubtful: {int((p[successes] < 0.5).sum())}/{int(successes.sum())}")
+        print(f"failures flagged doubtful: {int((p[failures] < TRUSTED_FROM).sum())}/{int(failures.sum())}")
+    print(f"successes flagged doubtful: {int((p[successes] < TRUSTED_FROM).sum())}/{int(successes.sum())}")
     print("\n| confidence | runs | mean confidence | success rate |\n|---|---:|---:|---:|")
     edges = [0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0001]
     for lo, hi in zip(edges[:-1], edges[1:]):
@@ -142,8 +144,8 @@ def report(p, y_test):
 
 def flagged(p, y):
     failures, successes = y == 0, y == 1
-    return (f"{int((p[failures] < 0.5).sum())}/{int(failures.sum())} failures and "
-            f"{int((p[successes] < 0.5).sum())}/{int(successes.sum())} successes flagged doubtful")
+    return (f"{int((p[failures] < TRUSTED_FROM).sum())}/{int(failures.sum())} failures and "
+            f"{int((p[successes] < TRUSTED_FROM).sum())}/{int(successes.sum())} successes flagged doubtful")
 
 
 def folds(paths):

@@ -29,13 +29,14 @@ MapOutputPaths LocalOutputPaths(const std::string& out_dir) {
   return paths;
 }
 
-// The pairs pairs.json lists: a fixed plan's, in plan order, then the loop
-// candidates; for keyframes every pair, in index order.
+// The pairs pairs.json lists: a fixed plan's, in plan order, then the
+// bridges and the loop candidates; for keyframes every pair, in index order.
 std::vector<PairIndex> ListedPairs(const PairingPlan& plan, const RegisteredPairs& registered) {
   std::vector<PairIndex> listed;
   if (!plan.keyframes) {
     listed = plan.chain;
     listed.insert(listed.end(), plan.extras.begin(), plan.extras.end());
+    listed.insert(listed.end(), registered.bridges.begin(), registered.bridges.end());
     listed.insert(listed.end(), registered.loops.begin(), registered.loops.end());
     return listed;
   }
@@ -75,7 +76,21 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   summary.pairs_doubtful = static_cast<int>(
       std::count_if(listed.begin(), listed.end(), [](const PairResult& r) { return r.doubtful; }));
   for (const PairResult& r : listed) summary.answered_by.push_back(r.answered_by);
+  for (const int scan : map.untrusted_scans) {
+    summary.untrusted_scans.push_back(
+        fs::path(run.batch.scans.at(static_cast<size_t>(scan)).path).filename().string());
+  }
+  summary.untrusted_line =
+      UntrustedScansLine(run.batch.scans, map.untrusted_scans, map.untrusted_left_out);
   return summary;
+}
+
+// What the stages after the plan's own pairs did.
+void SummariseStages(const RegisteredPairs& registered, const AssembledMap& map,
+                     MapOutputSummary& summary) {
+  summary.loops = SummariseLoops(registered, map.in_graph);
+  summary.bridges = BridgeSummaryLine(registered);
+  summary.bridges_tried = static_cast<int>(registered.bridges.size());
 }
 
 // Parallelism is across pairs, one registration thread each (config.threads
@@ -105,6 +120,9 @@ void PrintMapClosing(const MapOutputSummary& summary, const std::string& out_dir
   std::fprintf(stderr, "%s\n", DoubtfulSummary(summary.pairs_doubtful, summary.pairs).c_str());
   const std::string rungs = settings::RungSummary(summary.answered_by);
   if (!rungs.empty()) std::fprintf(stderr, "%s\n", rungs.c_str());
+  for (const std::string* line : {&summary.bridges, &summary.untrusted_line}) {
+    if (!line->empty()) std::fprintf(stderr, "%s\n", line->c_str());
+  }
   const std::string loops = summary.loops.Line();
   if (!loops.empty()) std::fprintf(stderr, "%s\n", loops.c_str());
 }
@@ -129,7 +147,7 @@ MapOutputSummary BuildLocalMap(const LocalRun& run, const std::string& out_dir, 
   }
   MapOutputSummary summary = WriteListingAndPreview(run, result.map, listed, out_dir);
   summary.pairs_reused = result.pairs.reused;
-  summary.loops = SummariseLoops(result.pairs, result.map.in_graph);
+  SummariseStages(result.pairs, result.map, summary);
   return summary;
 }
 
@@ -145,6 +163,8 @@ nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summa
           {"pairs", summary.pairs},
           {"pairs_reused", summary.pairs_reused},
           {"pairs_doubtful", summary.pairs_doubtful},
+          {"bridges_tried", summary.bridges_tried},
+          {"untrusted_scans", summary.untrusted_scans},
           {"loop_candidates", summary.loops.candidates},
           {"loops_closed", summary.loops.closed},
           {"loop_runtime_s", summary.loops.seconds},
@@ -178,9 +198,12 @@ MapOutputSummary AssembleStoredPairs(const LocalRun& run,
   PairFileStore store(batch.scans, batch.config, out_dir);
   TerminalProgress progress;
   fs::create_directories(out_dir);
-  if (batch.map.loops == LoopSearch::kAuto) {
+  {
     ThreadPool pool(threads);
-    RegisterLoopCandidates(batch, registered, store, progress, LocalExecution(pool));
+    RegisterBridges(batch, registered, store, progress, LocalExecution(pool));
+    if (batch.map.loops == LoopSearch::kAuto) {
+      RegisterLoopCandidates(batch, registered, store, progress, LocalExecution(pool));
+    }
   }
   const AssembledMap map =
       AssembleMap(batch, registered, store, progress, LocalOutputPaths(out_dir));
@@ -188,7 +211,7 @@ MapOutputSummary AssembleStoredPairs(const LocalRun& run,
   for (const PairIndex& pair : ListedPairs(batch.plan, registered))
     listed.push_back(registered.finished.at(pair));
   MapOutputSummary summary = WriteListingAndPreview(run, map, listed, out_dir);
-  summary.loops = SummariseLoops(registered, map.in_graph);
+  SummariseStages(registered, map, summary);
   return summary;
 }
 

@@ -27,6 +27,12 @@ struct MapOutputSummary {
   int pairs_reused = 0;           // taken from OUTDIR/pairs instead of registered
   std::vector<Rung> answered_by;  // of each pair listed, the rung whose answer was kept
   LoopStageSummary loops;         // the loop closures the map looked for itself
+  std::string bridges;            // BridgeSummaryLine; empty when none was tried
+  int bridges_tried = 0;
+  /// File names of the scans with no trusted pair, and whether they were
+  /// left out of the fusion.
+  std::vector<std::string> untrusted_scans;
+  std::string untrusted_line;  // UntrustedScansLine
 };
 
 /// What a caller may add to a local run: where progress goes (null: the

@@ -54,6 +54,7 @@ void PairFileStore::Save(int /*listing_order*/, const PairResult& result) {
 }
 
 // pairs.json carries in_graph; the pair files themselves do not.
-void PairFileStore::MarkInGraph(const std::vector<PairIndex>& /*in_graph*/) {}
+void PairFileStore::MarkInGraph(const std::vector<PairIndex>& /*in_graph*/,
+                                const std::map<PairIndex, std::string>& /*left_out*/) {}
 
 }  // namespace boicp::cli

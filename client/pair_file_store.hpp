@@ -22,7 +22,8 @@ class PairFileStore : public PairStore {
   /// and whose settings match the run's.
   std::vector<PairResult> LoadFinished() override;
   void Save(int listing_order, const PairResult& result) override;
-  void MarkInGraph(const std::vector<PairIndex>& in_graph) override;
+  void MarkInGraph(const std::vector<PairIndex>& in_graph,
+                   const std::map<PairIndex, std::string>& left_out) override;
 
  private:
   const std::vector<ScanSource>& scans_;

@@ -29,8 +29,9 @@ void JobPairStore::Save(int listing_order, const PairResult& result) {
   results_[pair] = std::move(proto);
 }
 
-void JobPairStore::MarkInGraph(const std::vector<PairIndex>& in_graph) {
-  store_.MarkPairsInGraph(spec_.job_id, in_graph);
+void JobPairStore::MarkInGraph(const std::vector<PairIndex>& in_graph,
+                               const std::map<PairIndex, std::string>& left_out) {
+  store_.MarkPairsInGraph(spec_.job_id, in_graph, left_out);
 }
 
 std::optional<v1::PairResult> JobPairStore::Result(const PairIndex& pair) const {

@@ -21,7 +21,8 @@ class JobPairStore : public PairStore {
 
   std::vector<PairResult> LoadFinished() override;
   void Save(int listing_order, const PairResult& result) override;
-  void MarkInGraph(const std::vector<PairIndex>& in_graph) override;
+  void MarkInGraph(const std::vector<PairIndex>& in_graph,
+                   const std::map<PairIndex, std::string>& left_out) override;
 
   /// The stored result of `pair` as the API reports it; nullopt when none is stored.
   std::optional<::boicp::v1::PairResult> Result(const PairIndex& pair) const;

@@ -251,16 +251,19 @@ class JobRun : public MapProgressSink {
     const MapOutputPaths outputs = JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id()));
     RequireOutputsWritten(outputs);
     const AssembledMap& map = result.map;
-    spdlog::info("job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points",
-                 job_.job_id(), spec_.batch.scans.size(), map.fusion.seconds,
-                 map.fusion.occupied_leaves, map.fusion.cloud_points);
+    spdlog::info(
+        "job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points", job_.job_id(),
+        spec_.batch.scans.size() - (map.untrusted_left_out ? map.untrusted_scans.size() : 0),
+        map.fusion.seconds, map.fusion.occupied_leaves, map.fusion.cloud_points);
     if (map.fusion.points_out_of_range > 0) {
       spdlog::warn("job {}: {} points lie beyond the OctoMap's key range and were left out",
                    job_.job_id(), map.fusion.points_out_of_range);
     }
-    if (const std::string loops = SummariseLoops(result.pairs, map.in_graph).Line();
-        !loops.empty()) {
-      spdlog::info("job {}: {}", job_.job_id(), loops);
+    for (const std::string& line :
+         {BridgeSummaryLine(result.pairs),
+          UntrustedScansLine(spec_.batch.scans, map.untrusted_scans, map.untrusted_left_out),
+          SummariseLoops(result.pairs, map.in_graph).Line()}) {
+      if (!line.empty()) spdlog::info("job {}: {}", job_.job_id(), line);
     }
     std::vector<v1::TrajectoryPose> trajectory;
     const std::vector<double> stamps = ScanTimestamps(spec_.batch.scans);

@@ -424,7 +424,8 @@ std::vector<StoredPair> JobStore::ReadPairs(const std::string& job_id) {
   return pairs;
 }
 
-void JobStore::MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph) {
+void JobStore::MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph,
+                                const std::map<PairIndex, std::string>& left_out) {
   const std::set<PairIndex> wanted(in_graph.begin(), in_graph.end());
   Locked([&] {
     SQLite::Transaction transaction(db_, SQLite::TransactionBehavior::IMMEDIATE);
@@ -432,6 +433,8 @@ void JobStore::MarkPairsInGraph(const std::string& job_id, const std::vector<Pai
       const PairIndex index{static_cast<int>(pair.result.source()),
                             static_cast<int>(pair.result.target())};
       pair.result.set_in_graph(wanted.count(index) > 0);
+      const auto reason = left_out.find(index);
+      pair.result.set_left_out_because(reason != left_out.end() ? reason->second : "");
       Run(db_,
           "UPDATE pair_results SET result = ?4 WHERE job_id = ?1 AND source = ?2 AND target = ?3",
           job_id, static_cast<int64_t>(index.source), static_cast<int64_t>(index.target),

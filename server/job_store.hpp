@@ -7,6 +7,7 @@
 // behind a mutex.
 
 #include <cstdint>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -115,7 +116,8 @@ class JobStore {
   /// In plan order.
   std::vector<StoredPair> GetPairs(const std::string& job_id);
   /// Sets in_graph on every stored pair of the job: true exactly for `in_graph`.
-  void MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph);
+  void MarkPairsInGraph(const std::string& job_id, const std::vector<PairIndex>& in_graph,
+                        const std::map<PairIndex, std::string>& left_out = {});
 
   void PutTrajectory(const std::string& job_id, const std::vector<v1::TrajectoryPose>& poses);
   /// Up to `page_size` (>= 1) pairs, in plan order, and up to as many poses,

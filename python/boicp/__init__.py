@@ -36,7 +36,7 @@ class Result:
     fitness: share of source points within the inlier distance of the target.
     rmse: RMS distance of those inliers, metres.
     confidence: in [0, 1], how far the answer is to be trusted.
-    doubtful: confidence below 0.5; check or re-run such a pair.
+    doubtful: confidence below 0.95; check or re-run such a pair.
     evaluations: ICP runs of every rung together.
     answered_by: the ladder's rung whose answer was kept.
     attempts: one dict per attempt (kind, mode, seed, fitness, confidence, ...).

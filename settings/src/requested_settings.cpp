@@ -84,6 +84,7 @@ MapBuildSettings MapBuildFromSettings(const RequestedSettings& settings) {
     throw InputError("map settings: cloud_voxel must be >= 0 (0 = resolution)");
   }
   map.loops = LoopSearchFromName(settings.loops, "loops");
+  map.untrusted_scans = UntrustedScansFromName(settings.untrusted_scans, "untrusted_scans");
   return map;
 }
 

@@ -155,6 +155,11 @@ std::vector<SettingField> BuildSchema() {
        "auto (look for loop closures on the chained poses and keep those registration trusts) "
        "or off (only the pairing's pairs)",
        kNoMapInRegister, PlainBinding<std::string>{&RS::loops}, kUnbounded},
+      {"untrusted_scans", "--untrusted-scans", nullptr, "untrusted_scans", kMapMsg,
+       "untrusted_scans", kMapFrontEnds,
+       "leave-out (a scan no trusted pair ties to the others is named and not fused) or place "
+       "(named, and fused where its best doubtful pair puts it)",
+       kNoMapInRegister, PlainBinding<std::string>{&RS::untrusted_scans}, kUnbounded},
   };
 }
 

@@ -14,6 +14,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -29,6 +30,7 @@
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/registration/bo_icp.hpp"
 
 #ifdef BOICP_TEST_WITH_DAEMON
 #include "../support/files_and_processes.hpp"
@@ -130,12 +132,6 @@ std::string RungLine(const json& pairs) {
   return line;
 }
 
-// The last line of a command's output (which ends with a newline).
-std::string LastLine(const std::string& text) {
-  const std::string body = text.substr(0, text.size() - 1);
-  return body.substr(body.rfind('\n') + 1);
-}
-
 // "000002-000003.json" for a pairs.json entry.
 std::string PairFileName(const json& pair) {
   char name[32];
@@ -164,7 +160,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
     ASSERT_TRUE(p.contains("doubtful") && p["doubtful"].is_boolean()) << p.dump();
     ASSERT_TRUE(p.contains("overlap") && p["overlap"].is_number()) << p.dump();
     ASSERT_TRUE(p.contains("search_reach") && p["search_reach"].is_number()) << p.dump();
-    EXPECT_EQ(p["doubtful"].get<bool>(), p["confidence"].get<double>() < 0.5);
+    EXPECT_EQ(p["doubtful"].get<bool>(), p["confidence"].get<double>() < kTrustedFrom);
     EXPECT_GT(p["overlap"].get<double>(), 0.0);
     doubtful += p["doubtful"].get<bool>();
     // Which rung answered, in pairs.json and in the pair's own file.
@@ -175,9 +171,9 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   }
   EXPECT_EQ(json::parse(first.out)["pairs_doubtful"], doubtful);
   EXPECT_THAT(first.err, HasSubstr(std::to_string(doubtful) + " of 3 pairs doubtful"));
-  // The closing line counts the rungs.
+  // A closing line counts the rungs.
   EXPECT_THAT(RungLine(pairs), ::testing::MatchesRegex("[0-9]+ [a-z]+(, [0-9]+ [a-z]+)*"));
-  EXPECT_EQ(LastLine(first.err), RungLine(pairs)) << first.err;
+  EXPECT_THAT(first.err, HasSubstr("\n" + RungLine(pairs) + "\n")) << first.err;
 
   // Files written before the marks existed (and before files had a format)
   // load as trusted, overlap and reach unknown, answered by the full search;
@@ -200,7 +196,8 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_EQ(json::parse(again.out)["pairs_reused"], 3);
   EXPECT_EQ(json::parse(again.out)["pairs_doubtful"], 1);
-  EXPECT_THAT(again.err, HasSubstr("1 of 3 pairs doubtful"));
+  // The doubtful pair is bridged: 1 -> 3 is listed besides the chain.
+  EXPECT_THAT(again.err, HasSubstr("1 of 4 pairs doubtful"));
   EXPECT_THAT(again.err, HasSubstr("(doubtful)"));
   pairs = json::parse(Slurp(out / "pairs.json"));
   EXPECT_EQ(pairs[0]["doubtful"], false);
@@ -209,7 +206,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   EXPECT_EQ(pairs[0]["answered_by"], "full-search");
   EXPECT_EQ(pairs[1]["answered_by"], "full-search");
   EXPECT_EQ(pairs[2]["doubtful"], true);
-  EXPECT_EQ(LastLine(again.err), RungLine(pairs)) << again.err;
+  EXPECT_THAT(again.err, HasSubstr("\n" + RungLine(pairs) + "\n")) << again.err;
   EXPECT_THAT(RungLine(pairs), HasSubstr("full")) << again.err;
 }
 
@@ -611,6 +608,64 @@ TEST_F(MapCli, SevenScenesDriveClosesItsOwnLoops) {
   EXPECT_LT(with, 0.8 * without);
 }
 
+// A drive whose scan 3 is noise: neither of its pairs can be trusted. The
+// bridge 2 -> 4 holds the chain together; scan 3 is named, kept in the
+// trajectory, and fused only with --untrusted-scans place.
+TEST_F(MapCli, ADoubtfulScanIsBridgedNamedAndLeftOut) {
+  const fs::path scans = MakeDrive(6);
+  Points noise;
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> coordinate(-20.0, 20.0);
+  for (int i = 0; i < 4000; ++i) {
+    noise.emplace_back(coordinate(random), coordinate(random), 0.1 * coordinate(random));
+  }
+  WriteXyz((scans / "scan003.xyz").string(), noise);
+
+  const fs::path out = dir_ / "out";
+  const RunResult r = Run("map " + scans.string() + " -o " + out.string() + Quick() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json summary = json::parse(r.out);
+  EXPECT_EQ(summary["untrusted_scans"], json::array({"scan003.xyz"}));
+  EXPECT_THAT(r.err, HasSubstr("1 scan has no trusted pair; left out of the map "
+                               "(--untrusted-scans place fuses them): scan003.xyz"));
+  EXPECT_THAT(r.err, HasSubstr("2 of 2 doubtful chain pairs bridged by a trusted pair over them"));
+
+  std::map<std::string, json> bridges;
+  for (const json& pair : json::parse(Slurp(out / "pairs.json"))) {
+    if (pair["kind"] == "bridge") {
+      bridges[std::to_string(pair["source"].get<int>()) + "->" +
+              std::to_string(pair["target"].get<int>())] = pair;
+    }
+  }
+  ASSERT_EQ(bridges.count("2->4"), 1u) << "the bridge one scan on from the first doubtful pair";
+  EXPECT_FALSE(bridges["2->4"]["doubtful"].get<bool>());
+  EXPECT_TRUE(bridges["2->4"]["in_graph"].get<bool>());
+  ASSERT_EQ(bridges.count("1->3"), 1u) << "the bridge one scan back, onto the noise";
+  EXPECT_THAT(bridges["1->3"]["left_out_because"].get<std::string>(),
+              HasSubstr("not trusted as a bridge"));
+
+  // Every scan keeps a pose; those after the noise follow the truth.
+  const std::vector<Transform> poses = ReadKittiTrajectory((out / "trajectory.kitti").string());
+  ASSERT_EQ(poses.size(), 6u);
+  for (const int i : {4, 5}) {
+    const Transform truth = truth_[0].inverse() * truth_[static_cast<size_t>(i)];
+    EXPECT_LT((poses[static_cast<size_t>(i)].topRightCorner<3, 1>() - truth.topRightCorner<3, 1>())
+                  .norm(),
+              0.2)
+        << "scan " << i;
+  }
+
+  // Placed, the noise adds its cells to the map.
+  const fs::path placed = dir_ / "placed";
+  const RunResult p = Run("map " + scans.string() + " -o " + placed.string() + Quick() +
+                          " --untrusted-scans place --json");
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_THAT(p.err, HasSubstr("1 scan has no trusted pair; placed by the best doubtful pair: "
+                               "scan003.xyz"));
+  EXPECT_GT(json::parse(p.out)["occupied_leaves"].get<int>(),
+            summary["occupied_leaves"].get<int>());
+}
+
 #ifdef BOICP_TEST_WITH_DAEMON
 namespace v1 = ::boicp::v1;
 
@@ -723,6 +778,7 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
       if (local == local_pairs.end()) continue;  // a keyframe probe only one side ran ahead to
       EXPECT_EQ(local->second["seed"].get<uint64_t>(), remote.seed());
       EXPECT_EQ(local->second["answered_by"], remote.answered_by());
+      EXPECT_EQ(local->second["left_out_because"], remote.left_out_because());
       EXPECT_EQ(local->second["evaluations"], remote.evaluations());
       for (int k = 0; k < 16; ++k) {
         EXPECT_NEAR(local->second["transform"][k / 4][k % 4].get<double>(), remote.transform().m(k),

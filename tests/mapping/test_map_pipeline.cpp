@@ -38,7 +38,10 @@ class MemoryStore : public PairStore {
     std::lock_guard<std::mutex> lock(mutex_);
     saved_.push_back(result.pair);
   }
-  void MarkInGraph(const std::vector<PairIndex>& in_graph) override { in_graph_ = in_graph; }
+  void MarkInGraph(const std::vector<PairIndex>& in_graph,
+                   const std::map<PairIndex, std::string>&) override {
+    in_graph_ = in_graph;
+  }
 
   std::vector<PairResult> stored_;
   std::mutex mutex_;

@@ -58,6 +58,21 @@ TEST(ChainPoses, AnchorsScanZeroAndPrefersEarlierEdges) {
   for (int i = 0; i < 8; ++i) EXPECT_LT(TranslationErrorM(chained.poses[i], truth[i]), 1e-9);
 }
 
+TEST(ChainPoses, PlacesAScanByItsMostConfidentDoubtfulPair) {
+  const std::vector<Transform> truth = {Pose(0, 0, 0), Pose(0.2, 2, 0), Pose(0.4, 4, 1)};
+  const Transform wrong = Pose(1.0, 5, 5);
+  // Scan 2 hangs on two doubtful pairs; the less confident one is listed first.
+  const std::vector<PairConstraint> constraints = {
+      {{0, 1}, Relative(truth[1], truth[0])},
+      {{1, 2}, wrong, InformationMatrix::Identity(), 0.2},
+      {{0, 2}, Relative(truth[2], truth[0]), InformationMatrix::Identity(), 0.6},
+  };
+  const ChainedPoses chained = ChainPoses(3, constraints);
+  EXPECT_FALSE(chained.in_tree[1]);
+  EXPECT_TRUE(chained.in_tree[2]);
+  EXPECT_LT(TranslationErrorM(chained.poses[2], truth[2]), 1e-9);
+}
+
 TEST(ChainPoses, ThrowsWhenAScanIsUnreached) {
   EXPECT_THROW(ChainPoses(3, {{{0, 1}, Transform::Identity()}}), InputError);
 }

@@ -35,7 +35,8 @@ class DiscardingStore : public PairStore {
  public:
   std::vector<PairResult> LoadFinished() override { return {}; }
   void Save(int, const PairResult&) override {}
-  void MarkInGraph(const std::vector<PairIndex>&) override {}
+  void MarkInGraph(const std::vector<PairIndex>&,
+                   const std::map<PairIndex, std::string>&) override {}
 };
 
 // KITTI scan `index`'s file name, as pairs.csv names it.

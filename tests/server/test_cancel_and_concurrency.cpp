@@ -109,6 +109,7 @@ TEST_F(CancelAndConcurrency, LoopClosuresOptimiseThePoseGraphAndWrongOnesArePrun
               .norm();
       EXPECT_EQ(p.in_graph(), error < 0.3)
           << job_id << " loop closure " << p.source() << "->0 is off by " << error << " m";
+      EXPECT_EQ(p.in_graph(), p.left_out_because().empty()) << p.left_out_because();
     }
     EXPECT_GE(in_graph, 5) << "4 chain pairs and at least the good loop closure";
     for (int i = 1; i < 5; ++i) {

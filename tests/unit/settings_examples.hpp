@@ -20,12 +20,13 @@ inline std::string ExampleWord(const std::string& flag) {
   if (flag == "--sensor") return "depth";
   if (flag == "--method") return "icp";
   if (flag == "--loops") return "off";
+  if (flag == "--untrusted-scans") return "place";
   return "B";
 }
 
 /// The command line that gives every setting of `frontend` a value:
 /// method icp, preset B, mode 6dof, ICP objective point, budget fixed,
-/// sensor depth, loops off, switches on,
+/// sensor depth, loops off, untrusted scans placed, switches on,
 /// the n-th number field n + 0.25 (the refinement voxel 0.25, counts n + 7),
 /// bounds "0.25,0.5,1.25".
 inline std::vector<std::string> ExampleArguments(Frontend frontend) {

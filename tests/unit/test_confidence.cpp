@@ -36,7 +36,7 @@ TEST(Confidence, MonotoneInFitness) {
 TEST(Confidence, NoInliersOrAWeakLoneAnswerIsDoubtful) {
   for (double resolution : {0.05, 0.5, 2.0}) {
     EXPECT_EQ(Confidence(Features(0.0, 0.0, resolution)), 0.0);
-    EXPECT_LT(Confidence(Features(0.2, 0.0, resolution)), kDoubtfulBelow);
+    EXPECT_LT(Confidence(Features(0.2, 0.0, resolution)), kTrustedFrom);
   }
 }
 
@@ -47,7 +47,7 @@ TEST(Confidence, AnAnswerAlmostNothingMatchesIsDoubtfulWhateverItsMargin) {
   for (double fitness : {0.001, 0.02, 0.049}) {
     for (double margin : {0.857, 1.0}) {
       for (double resolution : {0.0, 0.015, 0.5}) {
-        EXPECT_LT(Confidence(Features(fitness, margin, resolution)), kDoubtfulBelow)
+        EXPECT_LT(Confidence(Features(fitness, margin, resolution)), kTrustedFrom)
             << fitness << " " << margin << " " << resolution;
       }
     }
@@ -94,7 +94,7 @@ ConfidenceFeatures Measured(ConfidenceFeatures f) {
 TEST(Confidence, AMeasuredNearTieIsDoubtfulWhateverItsFit) {
   for (double fitness : {0.394, 0.7, 1.0}) {
     for (double margin : {0.0, 0.01, 0.014, 0.019}) {
-      EXPECT_LT(Confidence(Measured(Features(fitness, margin, 0.2))), kDoubtfulBelow)
+      EXPECT_LT(Confidence(Measured(Features(fitness, margin, 0.2))), kTrustedFrom)
           << fitness << " " << margin;
     }
     EXPECT_EQ(Confidence(Measured(Features(fitness, 0.01, 0.2))), 0.0);
@@ -107,7 +107,7 @@ TEST(Confidence, AMeasuredNearTieIsDoubtfulWhateverItsFit) {
     EXPECT_EQ(Confidence(Measured(Features(fitness, 0.5, 0.2))),
               Confidence(Features(fitness, 0.5, 0.2)));
   }
-  EXPECT_GT(Confidence(Features(0.8, 0.0, 0.2)), kDoubtfulBelow);
+  EXPECT_GT(Confidence(Features(0.8, 0.0, 0.2)), kTrustedFrom);
 }
 
 ConfidenceFeatures SeenThrough(ConfidenceFeatures f, double seen_through) {
@@ -141,8 +141,8 @@ TEST(Confidence, AnAnswerSeenThroughIsDoubtfulWhateverItsFit) {
   const ConfidenceFeatures bunny = Features(0.184, 0.818, 0.572);
   EXPECT_GT(Confidence(street), 0.5);
   EXPECT_GT(Confidence(bunny), 0.5);
-  EXPECT_LT(Confidence(SeenThrough(street, 0.353)), kDoubtfulBelow);
-  EXPECT_LT(Confidence(SeenThrough(bunny, 0.381)), kDoubtfulBelow);
+  EXPECT_LT(Confidence(SeenThrough(street, 0.353)), kTrustedFrom);
+  EXPECT_LT(Confidence(SeenThrough(bunny, 0.381)), kTrustedFrom);
 }
 
 }  // namespace

@@ -240,6 +240,38 @@ TEST(FpfhFeatures, BlocksSumTo100AndNeitherNormalSignsNorThreadsMatter) {
   EXPECT_TRUE(ComputeFpfhFeatures(index, normals, 5.0 * kVoxel, 2) == features);
 }
 
+// A scan moved so its centroid is the origin, as the search levels are, and
+// seen from where its sensor now lies, keeps its features: the normals face
+// the sensor, not the centroid.
+TEST(FpfhFeatures, CentredScansSeenFromTheirSensorKeepTheirFeatures) {
+  const Points scan =
+      VoxelDownsample(SimulateScan(MakeSyntheticStreet(5, 15.0),
+                                   PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8}), 35.0, 0.02, 4),
+                      kVoxel);
+  Point centre = Point::Zero();
+  for (const Point& p : scan) centre += p;
+  centre /= static_cast<double>(scan.size());
+  Points centred = scan;
+  for (Point& p : centred) p -= centre;
+  const NearestNeighborIndex index(scan), centred_index(centred);
+  const Points normals = EstimateSurfaceNormals(index, 2.0 * kVoxel, 1);
+  const FpfhFeatures features = ComputeFpfhFeatures(index, normals, 5.0 * kVoxel, 1);
+  const FpfhFeatures seen_from_sensor = ComputeFpfhFeatures(centred_index, normals, 5.0 * kVoxel, 1,
+                                                            kMaxFpfhNeighbours, Point(-centre));
+  const FpfhFeatures seen_from_centroid =
+      ComputeFpfhFeatures(centred_index, normals, 5.0 * kVoxel, 1);
+  const auto share_alike = [&](const FpfhFeatures& other) {
+    Eigen::Index alike = 0;
+    for (Eigen::Index i = 0; i < features.cols(); ++i) {
+      alike += (features.col(i) - other.col(i)).cwiseAbs().maxCoeff() < 1e-3F ? 1 : 0;
+    }
+    return static_cast<double>(alike) / static_cast<double>(features.cols());
+  };
+  // Alike up to rounding: a neighbour on the radius can fall either side.
+  EXPECT_GT(share_alike(seen_from_sensor), 0.95);
+  EXPECT_LT(share_alike(seen_from_centroid), 0.8) << "the test's scan must tell the two apart";
+}
+
 TEST(FpfhFeatures, FlatGroundPutsEveryPairInTheMiddleBins) {
   // A grid on the ground 1.8 m below the sensor: parallel normals, every pair
   // feature zero, so each block holds all its mass in bin 5.

@@ -100,6 +100,18 @@ PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
   return estimate;
 }
 
+void WriteTrajectories(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
+                       const MapOutputPaths& outputs) {
+  if (!outputs.trajectory_tum.empty()) {
+    WriteText(outputs.trajectory_tum,
+              [&](std::ostream& out) { WriteTumTrajectory(out, ScanTimestamps(scans), poses); });
+  }
+  if (!outputs.trajectory_kitti.empty()) {
+    WriteText(outputs.trajectory_kitti,
+              [&](std::ostream& out) { WriteKittiTrajectory(out, poses); });
+  }
+}
+
 FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
                         const MapBuildSettings& settings, const MapOutputPaths& outputs,
                         const AssemblyCallbacks& callbacks) {
@@ -191,14 +203,7 @@ FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<
     });
   }
   ThrowIfStopped(callbacks);
-  if (!outputs.trajectory_tum.empty()) {
-    WriteText(outputs.trajectory_tum,
-              [&](std::ostream& out) { WriteTumTrajectory(out, ScanTimestamps(scans), poses); });
-  }
-  if (!outputs.trajectory_kitti.empty()) {
-    WriteText(outputs.trajectory_kitti,
-              [&](std::ostream& out) { WriteKittiTrajectory(out, poses); });
-  }
+  WriteTrajectories(scans, poses, outputs);
   ThrowIfStopped(callbacks);
   if (want_cloud) {
     const Points merged = cloud.Centroids();

@@ -10,6 +10,17 @@
 namespace boicp {
 namespace {
 
+// Where a bridge over a doubtful chain pair between scans low < high starts
+// and ends: `back` scans before low, `on` scans after high.
+struct BridgeOffset {
+  int back = 0;
+  int on = 0;
+};
+
+// Tried in this order, each only over chain pairs no trusted bridge spans
+// yet: one scan back, one scan on, then both.
+constexpr BridgeOffset kBridgeOffsets[] = {{1, 0}, {0, 1}, {1, 1}};
+
 std::pair<int, int> Unordered(const PairIndex& p) {
   return {std::min(p.source, p.target), std::max(p.source, p.target)};
 }
@@ -33,10 +44,10 @@ std::vector<Point> ViewCentres(const std::vector<ScanSource>& scans,
   return centres;
 }
 
-// The loop stage's progress: only the pairs it registers are new.
-class LoopStageProgress : public MapProgressSink {
+// A later stage's progress: only the pairs it registers are new.
+class StageProgress : public MapProgressSink {
  public:
-  explicit LoopStageProgress(MapProgressSink& inner) : inner_(inner) {}
+  explicit StageProgress(MapProgressSink& inner) : inner_(inner) {}
   void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
     if (!reused) inner_.PairFinished(pair, reused, counts);
   }
@@ -49,20 +60,22 @@ class LoopStageProgress : public MapProgressSink {
   MapProgressSink& inner_;
 };
 
-bool IsTrustedLoop(const PairResult& result) { return result.confidence >= kLoopTrustedFrom; }
+bool IsTrusted(const PairResult& result) { return result.confidence >= kTrustedFrom; }
 
-// Why each edge the poses do not use, and each loop candidate that was no
-// edge, was left out.
+// Why each edge the poses do not use, and each bridge or loop candidate
+// that was no edge, was left out.
 std::map<PairIndex, std::string> LeftOut(const GraphEdges& edges, const RegisteredPairs& registered,
                                          const PoseEstimate& estimate) {
   std::map<PairIndex, std::string> left_out;
-  for (const PairIndex& p : registered.loops) {
-    const PairResult& loop = registered.finished.at(p);
-    if (IsTrustedLoop(loop)) continue;
-    char reason[96];
-    std::snprintf(reason, sizeof(reason), "not trusted as a loop (confidence %.3f < %.2f)",
-                  loop.confidence, kLoopTrustedFrom);
-    left_out[p] = reason;
+  for (const auto* found : {&registered.bridges, &registered.loops}) {
+    for (const PairIndex& p : *found) {
+      const PairResult& result = registered.finished.at(p);
+      if (IsTrusted(result)) continue;
+      char reason[96];
+      std::snprintf(reason, sizeof(reason), "not trusted as a %s (confidence %.3f < %.2f)",
+                    result.kind.c_str(), result.confidence, kTrustedFrom);
+      left_out[p] = reason;
+    }
   }
   for (size_t i = 0; i < edges.pairs.size(); ++i) {
     if (!estimate.kept.at(i)) left_out[edges.pairs[i]] = estimate.left_out_because.at(i);
@@ -87,10 +100,77 @@ GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& regi
   for (const PairIndex& p : plan.extras) {
     if (in_chain.count(Unordered(p)) == 0) add(p);
   }
-  for (const PairIndex& p : registered.loops) {
-    if (IsTrustedLoop(registered.finished.at(p))) add(p);
+  for (const auto* found : {&registered.bridges, &registered.loops}) {
+    for (const PairIndex& p : *found) {
+      if (IsTrusted(registered.finished.at(p))) add(p);
+    }
   }
   return edges;
+}
+
+void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
+                     MapProgressSink& progress, const PairExecution& execution) {
+  const int num_scans = static_cast<int>(batch.scans.size());
+  std::set<std::pair<int, int>> registered_already;
+  for (const auto& entry : registered.finished) registered_already.insert(Unordered(entry.first));
+  StageProgress bridge_progress(progress);
+  for (const BridgeOffset& offset : kBridgeOffsets) {
+    std::vector<PairIndex> open;
+    for (const PairIndex& link : registered.chain) {
+      if (!IsTrusted(registered.finished.at(link)) && !IsBridged(link, registered)) {
+        open.push_back(link);
+      }
+    }
+    if (open.empty()) return;
+    const PoseEstimate chained =
+        EstimatePoses(batch.scans, GraphConstraints(batch.plan, registered).constraints,
+                      BatchPoseGraphOptions(batch.config));
+    PairingPlan plan = PlanFixedPairs(registered.chain, batch.plan.extras);
+    std::vector<PairIndex> bridges;
+    for (const PairIndex& link : open) {
+      const auto [low, high] = Unordered(link);
+      const PairIndex bridge{low - offset.back, high + offset.on};
+      if (bridge.source < 0 || bridge.target >= num_scans ||
+          !registered_already.insert(Unordered(bridge)).second) {
+        continue;
+      }
+      plan.extras.push_back(bridge);
+      plan.chained_priors[bridge] = chained.poses[static_cast<size_t>(bridge.target)].inverse() *
+                                    chained.poses[static_cast<size_t>(bridge.source)];
+      plan.bridges.insert(bridge);
+      bridges.push_back(bridge);
+    }
+    if (bridges.empty()) continue;
+    RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan,
+                                                 store, bridge_progress, execution);
+    for (const PairIndex& p : bridges) {
+      registered.finished[p] = std::move(found.finished.at(p));
+      registered.bridges.push_back(p);
+    }
+  }
+}
+
+bool IsBridged(const PairIndex& link, const RegisteredPairs& registered) {
+  const auto [low, high] = Unordered(link);
+  for (const PairIndex& bridge : registered.bridges) {
+    const auto [from, to] = Unordered(bridge);
+    if (from <= low && to >= high && IsTrusted(registered.finished.at(bridge))) return true;
+  }
+  return false;
+}
+
+std::string BridgeSummaryLine(const RegisteredPairs& registered) {
+  if (registered.bridges.empty()) return "";
+  int doubtful = 0, bridged = 0;
+  for (const PairIndex& link : registered.chain) {
+    if (IsTrusted(registered.finished.at(link))) continue;
+    ++doubtful;
+    bridged += IsBridged(link, registered);
+  }
+  const size_t tried = registered.bridges.size();
+  return std::to_string(bridged) + " of " + std::to_string(doubtful) +
+         " doubtful chain pairs bridged by a trusted pair over them; " + std::to_string(tried) +
+         (tried == 1 ? " bridge" : " bridges") + " tried";
 }
 
 void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
@@ -109,11 +189,11 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
        LoopCandidatesFromPoses(chained.poses, ViewCentres(batch.scans, chained.poses), options)) {
     if (registered_already.count(Unordered(c.pair)) != 0) continue;
     plan.extras.push_back(c.pair);
-    plan.loop_priors[c.pair] = c.prior;
+    plan.chained_priors[c.pair] = c.prior;
     loops.push_back(c.pair);
   }
   if (loops.empty()) return;
-  LoopStageProgress loop_progress(progress);
+  StageProgress loop_progress(progress);
   RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan, store,
                                                loop_progress, execution);
   for (const PairIndex& p : loops) registered.finished[p] = std::move(found.finished.at(p));
@@ -168,16 +248,36 @@ AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registere
       EstimatePoses(batch.scans, edges.constraints, BatchPoseGraphOptions(batch.config));
   assembled.in_graph = PairsInGraph(edges, assembled.estimate);
   assembled.left_out = LeftOut(edges, registered, assembled.estimate);
-  store.MarkInGraph(assembled.in_graph);
+  store.MarkInGraph(assembled.in_graph, assembled.left_out);
   progress.PosesEstimated(assembled.estimate, assembled.in_graph);
 
-  progress.StageStarted(MapStage::kFusing, static_cast<int>(batch.scans.size()));
+  const int num_scans = static_cast<int>(batch.scans.size());
+  assembled.untrusted_scans =
+      ScansWithoutTrustedPair(num_scans, edges.constraints, assembled.estimate.kept);
+  // With no trusted pair at all, there is nothing better to fuse instead.
+  assembled.untrusted_left_out = batch.map.untrusted_scans == UntrustedScans::kLeaveOut &&
+                                 !assembled.untrusted_scans.empty() &&
+                                 static_cast<int>(assembled.untrusted_scans.size()) < num_scans;
+  std::vector<ScanSource> fused_scans;
+  std::vector<Transform> fused_poses;
+  const std::set<int> left_out(assembled.untrusted_scans.begin(), assembled.untrusted_scans.end());
+  for (int i = 0; i < num_scans; ++i) {
+    if (assembled.untrusted_left_out && left_out.count(i) != 0) continue;
+    fused_scans.push_back(batch.scans[static_cast<size_t>(i)]);
+    fused_poses.push_back(assembled.estimate.poses[static_cast<size_t>(i)]);
+  }
+  // The trajectories keep every scan, fused or not.
+  MapOutputPaths fusion_outputs = outputs;
+  fusion_outputs.trajectory_tum.clear();
+  fusion_outputs.trajectory_kitti.clear();
+
+  progress.StageStarted(MapStage::kFusing, static_cast<int>(fused_scans.size()));
   if (hooks.before_fusion) hooks.before_fusion();
   AssemblyCallbacks callbacks;
   callbacks.stop_requested = stop_requested;
   callbacks.progress = [&progress](const AssemblyProgress& p) { progress.AssemblyStep(p); };
-  assembled.fusion =
-      FuseScans(batch.scans, assembled.estimate.poses, batch.map, outputs, callbacks);
+  assembled.fusion = FuseScans(fused_scans, fused_poses, batch.map, fusion_outputs, callbacks);
+  WriteTrajectories(batch.scans, assembled.estimate.poses, outputs);
   return assembled;
 }
 
@@ -187,6 +287,7 @@ MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapPro
   MapPipelineResult result;
   result.pairs = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, batch.plan, store,
                                       progress, execution);
+  RegisterBridges(batch, result.pairs, store, progress, execution);
   if (batch.map.loops == LoopSearch::kAuto) {
     RegisterLoopCandidates(batch, result.pairs, store, progress, execution);
   }

@@ -54,7 +54,7 @@ const std::vector<PairResultField>& PairResultFields() {
       // The plan says why each pair ran, when the pipeline lists it.
       {"kind", &PairResult::kind, kPairListing | kPairApi},
       {"found_by", &PairResult::found_by, kPairListing | kPairApi},
-      {"left_out_because", &PairResult::left_out_because, kPairListing},
+      {"left_out_because", &PairResult::left_out_because, kPairListing | kPairApi},
       {"finished_at", &PairResult::finished_at, kPairApi},
   };
   return kFields;

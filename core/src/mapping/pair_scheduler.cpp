@@ -54,11 +54,16 @@ bool PlanUses(const PairingPlan& plan, const PairIndex& pair) {
 }
 
 // Why `result`'s pair ran, as the plan says (PairResult::kind).
+bool IsLoopCandidate(const PairingPlan& plan, const PairIndex& pair) {
+  return plan.bridges.count(pair) == 0 && plan.chained_priors.count(pair) != 0;
+}
+
 void MarkKind(const PairingPlan& plan, PairResult& result) {
   const bool extra =
       std::find(plan.extras.begin(), plan.extras.end(), result.pair) != plan.extras.end();
-  const bool loop = plan.loop_priors.count(result.pair) != 0;
-  result.kind = loop ? "loop" : extra ? "extra" : "chain";
+  const bool bridge = plan.bridges.count(result.pair) != 0;
+  const bool loop = IsLoopCandidate(plan, result.pair);
+  result.kind = bridge ? "bridge" : loop ? "loop" : extra ? "extra" : "chain";
   result.found_by = loop ? "poses" : "";
 }
 
@@ -299,10 +304,12 @@ class PairScheduler {
     } else {
       try {
         ScaledPreparation::Level& level = preparation_.For(pair);
-        const auto loop_prior = plan_.loop_priors.find(pair);
-        PairResult result = RegisterBatchPair(scans_, pair, level.config, *level.prepared, stop,
-                                              loop_prior != plan_.loop_priors.end()
-                                                  ? std::optional<Transform>(loop_prior->second)
+        const auto prior = plan_.chained_priors.find(pair);
+        BoIcpConfig config = level.config;
+        config.full_search_when_doubtful = !IsLoopCandidate(plan_, pair);
+        PairResult result = RegisterBatchPair(scans_, pair, config, *level.prepared, stop,
+                                              prior != plan_.chained_priors.end()
+                                                  ? std::optional<Transform>(prior->second)
                                                   : std::nullopt);
         MarkKind(plan_, result);
         store_.Save(order, result);

@@ -179,7 +179,7 @@ InformationMatrix CalibratedInformation(const InformationMatrix& information, do
 }
 
 bool IsDoubtfulEdge(const PairConstraint& constraint) {
-  return constraint.confidence < kDoubtfulBelow;
+  return constraint.confidence < kTrustedFrom;
 }
 
 ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constraints,
@@ -195,22 +195,26 @@ ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constr
     }
   }
 
-  // Kruskal in the given order, trusted constraints before doubtful ones:
-  // the first constraint joining two parts wins.
+  // Kruskal: trusted constraints in the given order, then doubtful ones
+  // from the most confident; the first constraint joining two parts wins.
+  std::vector<size_t> order(constraints.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const bool doubtful_a = IsDoubtfulEdge(constraints[a]);
+    if (doubtful_a != IsDoubtfulEdge(constraints[b])) return !doubtful_a;
+    return doubtful_a && constraints[a].confidence > constraints[b].confidence;
+  });
   std::vector<int> parent(static_cast<size_t>(num_scans));
   std::iota(parent.begin(), parent.end(), 0);
-  for (const bool doubtful_pass : {false, true}) {
-    for (size_t e = 0; e < constraints.size(); ++e) {
-      if (IsDoubtfulEdge(constraints[e]) != doubtful_pass) continue;
-      const PairIndex& p = constraints[e].pair;
-      const int a = FindRoot(parent, p.source), b = FindRoot(parent, p.target);
-      if (a == b) {
-        ++out.loop_closures;
-        continue;
-      }
-      parent[a] = b;
-      out.in_tree[e] = true;
+  for (const size_t e : order) {
+    const PairIndex& p = constraints[e].pair;
+    const int a = FindRoot(parent, p.source), b = FindRoot(parent, p.target);
+    if (a == b) {
+      ++out.loop_closures;
+      continue;
     }
+    parent[a] = b;
+    out.in_tree[e] = true;
   }
 
   out.poses.assign(static_cast<size_t>(num_scans), Transform::Identity());

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "boicp/registration/auto_settings.hpp"
+#include "boicp/registration/confidence.hpp"
 #include "boicp/registration/feature_hypotheses.hpp"
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/scan_features.hpp"
@@ -56,7 +57,8 @@ Registered RegisterFixed(const ScanPyramid& source, const ScanPyramid& target,
   Registered out;
   const auto search = [&](const BoIcpConfig& attempt_config) {
     const auto started = std::chrono::steady_clock::now();
-    SearchOutcome outcome = SearchAndRefine(source, target, attempt_config, prior, callbacks);
+    SearchOutcome outcome =
+        SearchAndRefine(source, target, attempt_config, prior, callbacks, config.seed);
     out.attempts.push_back(AttemptOf(AttemptKind::kSearch, attempt_config, outcome,
                                      static_cast<int>(outcome.history.size()),
                                      attempt_config.refine_candidates, started));
@@ -69,7 +71,7 @@ Registered RegisterFixed(const ScanPyramid& source, const ScanPyramid& target,
     out.kept = std::move(candidate);
     kept_index = out.attempts.size() - 1;
   };
-  if (config.retry_when_doubtful && out.kept.confidence < kDoubtfulBelow) {
+  if (config.retry_when_doubtful && out.kept.confidence < kTrustedFrom) {
     const auto started = std::chrono::steady_clock::now();
     SearchOutcome wider = out.kept;
     RefineEnds(wider, kWiderRefinementEnds, config, callbacks);
@@ -77,7 +79,7 @@ Registered RegisterFixed(const ScanPyramid& source, const ScanPyramid& target,
         AttemptOf(AttemptKind::kWiderRefinement, config, wider, 0, kWiderRefinementEnds, started));
     keep_if_better(std::move(wider));
   }
-  if (config.retry_when_doubtful && out.kept.confidence < kDoubtfulBelow)
+  if (config.retry_when_doubtful && out.kept.confidence < kTrustedFrom)
     keep_if_better(search(RetryConfig(config)));
   out.attempts[kept_index].kept = true;
   out.rung = kept_index == 0 ? Rung::kFullSearch : Rung::kRetry;
@@ -117,14 +119,16 @@ std::vector<Transform> ProbesAround(const Transform& guess, const Point& source_
 
 // A scan's features at `step` from its search level: the pyramid's own,
 // computed once for every pair, when the pyramid was built at this search
-// voxel.
+// voxel. Its sensor stood at the scan frame's origin, -centre in the
+// centred search level.
 std::shared_ptr<const ScanFeatures> FeaturesOf(const ScanPyramid& scan, const Points& search_level,
                                                int step, const BoIcpConfig& config) {
+  const Point sensor = -scan.centre;
   if (!scan.voxels.empty() && scan.voxels[0] == config.voxel) {
-    return scan.features->At(search_level, config.voxel, step, config.threads);
+    return scan.features->At(search_level, config.voxel, step, config.threads, sensor);
   }
   return std::make_shared<const ScanFeatures>(
-      ComputeScanFeatures(search_level, config.voxel, step, config.threads));
+      ComputeScanFeatures(search_level, config.voxel, step, config.threads, sensor));
 }
 
 // Feature hypotheses of the search clouds: both scans' FPFH at the coarser
@@ -150,11 +154,23 @@ std::vector<Transform> FeatureGuesses(const ScanPyramid& source_scan,
   return guesses;
 }
 
-// Budget::kAuto: the escalation ladder. Each rung runs only while every
-// answer so far is doubtful, and hands what it learned (its answer, its
-// hypotheses) to the next as starts; the most confident answer is kept. The
-// rungs share one prepared pair, so their answers are compared on the same
-// finest points.
+// One answer assessed twice: a rival basin that one rung found stays found,
+// though a later rung's search may not visit it, so the later assessment
+// keeps the smallest margin measured to a rival.
+void KeepRivalsFound(const SearchOutcome& earlier, SearchOutcome& later) {
+  if (!earlier.features.margin_measured) return;
+  if (later.features.margin_measured && later.features.margin <= earlier.features.margin) return;
+  later.features.margin = earlier.features.margin;
+  later.features.margin_measured = true;
+  later.confidence = Confidence(later.features);
+}
+
+// Budget::kAuto: the escalation ladder. Each rung runs only while the
+// answer kept so far is doubtful, and hands what it learned (its answer, its
+// hypotheses) to the next as starts. The rungs share their finest points,
+// so the answer kept is the one that fits the most of them (or the latest
+// assessment of it); keeping the most confident instead would report the
+// luckiest of several estimates.
 class Ladder {
  public:
   Ladder(const ScanPyramid& source, const ScanPyramid& target, const BoIcpConfig& config,
@@ -175,6 +191,7 @@ class Ladder {
     const PairContext pair = MakePairContext(*prepared_, config_);
     StagedSearch search(pair, frame_, config_, callbacks_);
     if (SearchRung(search, /*short_budget=*/true)) return Finish();
+    if (!config_.full_search_when_doubtful) return Finish();
     if (SearchRung(search, /*short_budget=*/false)) return Finish();
     if (config_.retry_when_doubtful) RetryRung();
     return Finish();
@@ -264,16 +281,22 @@ class Ladder {
     Consider(std::move(out), Rung::kRetry, attempt);
   }
 
-  // Keeps `out` when it is the most confident answer so far; true once the
-  // kept answer is trusted.
+  // Keeps `out` when it fits more of the finest points than the answer kept
+  // so far, or ends in its basin: then it is the same answer, assessed again
+  // with every rival found so far. True once the kept answer is trusted.
   bool Consider(SearchOutcome&& out, Rung rung, Attempt attempt) {
-    if (attempts_.empty() || out.confidence > kept_.confidence) {
+    const bool same_answer =
+        !attempts_.empty() &&
+        SameBasin(out.refined.transform, kept_.refined.transform, config_.voxel);
+    if (same_answer) KeepRivalsFound(kept_, out);
+    if (attempts_.empty() || same_answer ||
+        out.refined.score.fitness > kept_.refined.score.fitness) {
       kept_ = std::move(out);
       rung_ = rung;
       kept_index_ = attempts_.size();
     }
     attempts_.push_back(attempt);
-    return kept_.confidence >= kDoubtfulBelow;
+    return kept_.confidence >= kTrustedFrom;
   }
 
   Registered Finish() {
@@ -370,7 +393,7 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   result.probability_better = kept.probability_better;
   result.features = kept.features;
   result.confidence = kept.confidence;
-  result.doubtful = result.confidence < kDoubtfulBelow;
+  result.doubtful = result.confidence < kTrustedFrom;
   result.gp_mean = kept.gp_mean;
   result.gp_std = kept.gp_std;
   result.answered_by = registered.rung;

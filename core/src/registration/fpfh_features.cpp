@@ -34,10 +34,10 @@ struct PairFeature {
 };
 
 // The normal's sign is arbitrary, and flipping one changes every feature it
-// enters; facing the origin (the sensor, in a scan's own frame) fixes it in a
-// way rotations about the sensor preserve.
-Point FacingOrigin(const Point& point, const Point& normal) {
-  return normal.dot(point) > 0.0 ? Point(-normal) : normal;
+// enters; facing the sensor fixes it in a way rotations about the sensor
+// preserve.
+Point FacingViewpoint(const Point& point, const Point& normal, const Point& viewpoint) {
+  return normal.dot(point - viewpoint) > 0.0 ? Point(-normal) : normal;
 }
 
 // Precondition: p_s != p_t. The frame sits at whichever point's normal is
@@ -155,12 +155,13 @@ void CheckFpfhInputs(const NearestNeighborIndex& cloud, const Points& normals, d
 }  // namespace
 
 FpfhFeatures ComputeFpfhFeatures(const NearestNeighborIndex& cloud, const Points& normals,
-                                 double radius, int threads, size_t max_neighbours) {
+                                 double radius, int threads, size_t max_neighbours,
+                                 const Point& viewpoint) {
   CheckFpfhInputs(cloud, normals, radius, max_neighbours);
   const Points& points = cloud.points();
   const size_t n = points.size();
   Points oriented(n);
-  for (size_t i = 0; i < n; ++i) oriented[i] = FacingOrigin(points[i], normals[i]);
+  for (size_t i = 0; i < n; ++i) oriented[i] = FacingViewpoint(points[i], normals[i], viewpoint);
 
   std::vector<std::vector<FpfhNeighbour>> neighbourhoods(n);
   SpfhMatrix spfh(kFpfhDescriptorSize, static_cast<Eigen::Index>(n));

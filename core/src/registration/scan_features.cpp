@@ -22,19 +22,20 @@ double FeatureVoxel(double search_voxel, int step) {
 }
 
 ScanFeatures ComputeScanFeatures(const Points& search_level, double search_voxel, int step,
-                                 int threads) {
+                                 int threads, const Point& viewpoint) {
   ScanFeatures scan;
   scan.voxel = FeatureVoxel(search_voxel, step);
   const NearestNeighborIndex cloud(VoxelDownsample(search_level, scan.voxel));
   const Points normals = EstimateSurfaceNormals(cloud, 3.0 * scan.voxel, threads);
-  scan.features = ComputeFpfhFeatures(cloud, normals, 5.0 * scan.voxel, threads);
+  scan.features =
+      ComputeFpfhFeatures(cloud, normals, 5.0 * scan.voxel, threads, kMaxFpfhNeighbours, viewpoint);
   scan.points = cloud.points();
   return scan;
 }
 
 std::shared_ptr<const ScanFeatures> ScanFeatureMemo::At(const Points& search_level,
-                                                        double search_voxel, int step,
-                                                        int threads) {
+                                                        double search_voxel, int step, int threads,
+                                                        const Point& viewpoint) {
   Entry* entry = nullptr;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -45,7 +46,7 @@ std::shared_ptr<const ScanFeatures> ScanFeatureMemo::At(const Points& search_lev
   // Outside the map's lock, so that other steps are computed meanwhile.
   std::call_once(entry->once, [&] {
     entry->features = std::make_shared<const ScanFeatures>(
-        ComputeScanFeatures(search_level, search_voxel, step, threads));
+        ComputeScanFeatures(search_level, search_voxel, step, threads, viewpoint));
     ++computed_;
   });
   return entry->features;

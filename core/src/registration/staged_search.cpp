@@ -404,8 +404,10 @@ void StagedSearch::Run(bool short_budget) {
 
 SearchOutcome SearchAndRefine(const ScanPyramid& source, const ScanPyramid& target,
                               const BoIcpConfig& config, const std::optional<Transform>& prior,
-                              const RegistrationCallbacks& callbacks) {
-  const auto prepared = std::make_shared<const PreparedPair>(PreparePair(source, target, config));
+                              const RegistrationCallbacks& callbacks,
+                              std::optional<uint64_t> level_seed) {
+  const auto prepared =
+      std::make_shared<const PreparedPair>(PreparePair(source, target, config, level_seed));
   const PairContext pair = MakePairContext(*prepared, config);
   const SearchFrame frame = MakeSearchFrame(*prepared, prior);
   SearchOutcome out = OutcomeOf(prepared, frame, config);

@@ -4,6 +4,7 @@
 // what the fixed budget and every rung of the ladder share (bo_icp.cpp).
 // Internal to core.
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -125,10 +126,13 @@ class StagedSearch {
 };
 
 // One whole search from the pair's own prepared clouds, its
-// refine_candidates best distinct ends refined and assessed.
+// refine_candidates best distinct ends refined and assessed. The finer
+// levels are subsampled with `level_seed` (default config.seed), so a retry
+// with another seed scores its answer on the first search's points.
 SearchOutcome SearchAndRefine(const ScanPyramid& source, const ScanPyramid& target,
                               const BoIcpConfig& config, const std::optional<Transform>& prior,
-                              const RegistrationCallbacks& callbacks);
+                              const RegistrationCallbacks& callbacks,
+                              std::optional<uint64_t> level_seed = std::nullopt);
 
 // A doubtful answer may be a basin that only looked best on coarse voxels
 // (a low-overlap view slid along a wall scores like the true one there),

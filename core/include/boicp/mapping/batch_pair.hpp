@@ -74,7 +74,7 @@ BatchSettingsChoice ApplyBatchSettings(const std::vector<ScanSource>& scans, BoI
                                        OccupancySettings& occupancy, const MapAutoFields& map_auto);
 
 /// The closing line of a batch: "2 of 40 pairs doubtful" (doubtful =
-/// confidence below kDoubtfulBelow).
+/// confidence below kTrustedFrom).
 std::string DoubtfulSummary(int doubtful, int total);
 
 /// A registered pair's translation error along one axis, as a fraction of

@@ -14,6 +14,7 @@
 #include "boicp/mapping/map_stage.hpp"
 #include "boicp/mapping/occupancy_map.hpp"
 #include "boicp/mapping/pose_graph.hpp"
+#include "boicp/mapping/untrusted_scans.hpp"
 
 namespace boicp {
 
@@ -50,6 +51,8 @@ struct MapBuildSettings {
   /// LimitExceeded, naming --max-fusion-mb, rather than pass it.
   size_t max_fusion_bytes = 0;
   LoopSearch loops = LoopSearch::kAuto;  // whether the map looks for loop closures itself
+  /// Whether a scan with no trusted pair is fused (UntrustedScans).
+  UntrustedScans untrusted_scans = UntrustedScans::kLeaveOut;
 };
 
 /// Where to write each output; an empty path skips that output. Every file
@@ -89,6 +92,12 @@ struct FusionSummary {
 /// scan that no longer loads, Cancelled when stop_requested fires,
 /// LimitExceeded past settings.max_fusion_bytes, and std::runtime_error
 /// when an output cannot be written.
+/// Writes outputs.trajectory_tum and outputs.trajectory_kitti, those that
+/// are set, with one pose per scan. Throws std::runtime_error when a file
+/// cannot be written.
+void WriteTrajectories(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
+                       const MapOutputPaths& outputs);
+
 FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
                         const MapBuildSettings& settings, const MapOutputPaths& outputs,
                         const AssemblyCallbacks& callbacks = {});

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -49,9 +50,12 @@ struct PairingPlan {
   double overlap_threshold = 0.7;  // keyframes only, in (0, 1]
   std::vector<PairIndex> chain;    // fixed plans: chained first into poses
   std::vector<PairIndex> extras;   // loop closures on top of the chain
-  /// Extras that are loop candidates found on the chained poses, each with
-  /// the chain's T_target_source: their searches are centred there.
-  std::map<PairIndex, Transform> loop_priors;
+  /// Extras found on the chained poses (bridges and loop candidates), each
+  /// with the chain's T_target_source: their searches are centred there.
+  std::map<PairIndex, Transform> chained_priors;
+  /// Of those, the bridges over doubtful chain pairs; the others are loop
+  /// candidates.
+  std::set<PairIndex> bridges;
 };
 
 /// A fixed plan: `chain` (consecutive or explicit pairs) plus `extras`.

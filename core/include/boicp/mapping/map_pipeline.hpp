@@ -25,13 +25,27 @@ struct GraphEdges {
 };
 
 /// Preconditions: `registered.finished` holds every pair of
-/// registered.chain, plan.extras and registered.loops. Of the loops, only
-/// those trusted to kLoopTrustedFrom are edges.
+/// registered.chain, plan.extras, registered.bridges and registered.loops.
+/// Of the bridges and loops, only the trusted ones (kTrustedFrom) are edges.
 GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& registered);
 
-/// A loop candidate closes a loop only when its estimated probability of
-/// being right is at least this: a wrong loop bends the whole map.
-constexpr double kLoopTrustedFrom = 0.95;
+/// The bridge stage of a batch whose plan is registered: where a chain pair
+/// is doubtful, the scans around it are registered directly, one scan back
+/// (low - 1 onto high), then one scan on (low onto high + 1), then both,
+/// each round only over chain pairs no trusted bridge spans yet, with the
+/// chain's relative pose as the prior. Bridges are stored in `store` and
+/// added to registered.finished and registered.bridges; a trusted one is an
+/// edge that the chain prefers to the doubtful pair. Throws what
+/// RegisterPlannedPairs throws.
+void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
+                     MapProgressSink& progress, const PairExecution& execution);
+
+/// True when a trusted bridge of `registered` spans the chain pair `link`.
+bool IsBridged(const PairIndex& link, const RegisteredPairs& registered);
+
+/// "3 of 5 doubtful chain pairs bridged by a trusted pair over them; 9
+/// bridges tried"; empty when no bridge was tried.
+std::string BridgeSummaryLine(const RegisteredPairs& registered);
 
 /// The loop stage of a batch whose plan is registered: candidates found on
 /// the poses of `registered` (LoopCandidatesFromPoses, each scan seen from
@@ -65,8 +79,13 @@ std::vector<PairIndex> PairsInGraph(const GraphEdges& edges, const PoseEstimate&
 struct AssembledMap {
   PoseEstimate estimate;            // poses are T_map_scan
   std::vector<PairIndex> in_graph;  // the pairs the poses use
-  /// Why each loop closure or extra pair the poses do not use was left out.
+  /// Why each loop closure, bridge or extra pair the poses do not use was left out.
   std::map<PairIndex, std::string> left_out;
+  /// Scans no trusted pair in the graph touches (ScansWithoutTrustedPair).
+  std::vector<int> untrusted_scans;
+  /// Whether they were left out of the fusion: batch.map.untrusted_scans is
+  /// kLeaveOut and some other scan has a trusted pair.
+  bool untrusted_left_out = false;
   FusionSummary fusion;
 };
 
@@ -79,7 +98,9 @@ struct MapPipelineHooks {
   std::function<void()> before_fusion;
 };
 
-/// Poses from the registered pairs, then fusion into `outputs`. Reports the
+/// Poses from the registered pairs, then fusion into `outputs` of every scan
+/// but those left out as untrusted (AssembledMap); the trajectories keep
+/// every scan. Reports the
 /// stages to `progress`, marks the used pairs in `store`, runs `hooks` at
 /// their points. Throws InputError when the pairs leave a scan unreached or
 /// a scan no longer loads, Cancelled when `stop_requested` fires during
@@ -94,7 +115,7 @@ struct MapPipelineResult {
   AssembledMap map;
 };
 
-/// The whole pipeline: RegisterPlannedPairs, RegisterLoopCandidates when
+/// The whole pipeline: RegisterPlannedPairs, RegisterBridges, RegisterLoopCandidates when
 /// batch.map.loops is kAuto, then AssembleMap (with the execution's
 /// stop_requested). Throws what any of them throws.
 MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapProgressSink& progress,

@@ -29,7 +29,7 @@ struct PairResult {
   /// weight. Results stored before confidence was calibrated read as 1 and
   /// not doubtful: fully trusted, as they were then.
   double confidence = 1.0;
-  bool doubtful = false;  // confidence < kDoubtfulBelow
+  bool doubtful = false;  // confidence < kTrustedFrom
   /// RegistrationResult::overlap; unknown in results stored before it was computed.
   std::optional<double> overlap;
   /// RegistrationResult::search_reach; unknown in results stored before it was computed.
@@ -45,8 +45,9 @@ struct PairResult {
   /// False for a keyframe probe or loop closure the final poses leave out.
   bool in_graph = true;
   /// Why the pair was registered: "chain" (the plan's own pairs, keyframe
-  /// probes included), "extra" (listed by the user) or "loop" (a loop
-  /// candidate the map found itself).
+  /// probes included), "extra" (listed by the user), "bridge" (joins the
+  /// scans around a doubtful chain pair) or "loop" (a loop candidate the map
+  /// found itself).
   std::string kind = "chain";
   /// For a loop: how its candidate was found, "poses" (its scans' views lie
   /// within reach under the chained poses); empty for the other kinds.

@@ -34,6 +34,7 @@ struct PairExecution {
 struct RegisteredPairs {
   std::map<PairIndex, PairResult> finished;  // every finished pair the plan uses or probed
   std::vector<PairIndex> chain;              // the chain the poses are built from
+  std::vector<PairIndex> bridges;            // pairs over doubtful chain pairs, in the order tried
   std::vector<PairIndex> loops;              // loop candidates registered, in the order found
   int reused = 0;                            // of `finished`, those loaded from the store
 };

@@ -4,6 +4,8 @@
 // and `boicp merge`. The pipeline saves each pair before it reports it, so a
 // run killed at any point resumes with only the unfinished pairs.
 
+#include <map>
+#include <string>
 #include <vector>
 
 #include "boicp/mapping/map_pairs.hpp"
@@ -26,8 +28,9 @@ class PairStore {
   virtual void Save(int listing_order, const PairResult& result) = 0;
 
   /// Records which pairs the final poses use (the others were pruned loop
-  /// closures or unused keyframe probes).
-  virtual void MarkInGraph(const std::vector<PairIndex>& in_graph) = 0;
+  /// closures or unused keyframe probes), and why some were left out.
+  virtual void MarkInGraph(const std::vector<PairIndex>& in_graph,
+                           const std::map<PairIndex, std::string>& left_out) = 0;
 };
 
 }  // namespace boicp

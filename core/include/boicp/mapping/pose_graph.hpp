@@ -28,7 +28,7 @@ struct PairConstraint {
   double confidence = 1.0;
 };
 
-/// True when the constraint's confidence is below kDoubtfulBelow.
+/// True when the constraint's confidence is below kTrustedFrom.
 bool IsDoubtfulEdge(const PairConstraint& constraint);
 
 /// Poses T_map_scan from chaining, and which constraints the chain used.
@@ -43,8 +43,8 @@ struct ChainedPoses {
 /// Chains the constraints into poses with T_map_scan0 = `anchor`: a spanning
 /// tree is grown from the trusted constraints in the order given (so a
 /// sequential chain listed first is preferred over loop closures), then
-/// from the doubtful ones, so a doubtful pair is chained only where no
-/// trusted one connects the same parts. Each pose follows T_map_source =
+/// from the doubtful ones, most confident first, so a doubtful pair is
+/// chained only where no trusted one connects the same parts. Each pose follows T_map_source =
 /// T_map_target * T_target_source along the tree. Throws InputError when a
 /// scan is not reached.
 ChainedPoses ChainPoses(int num_scans, const std::vector<PairConstraint>& constraints,

@@ -71,8 +71,11 @@ struct Attempt {
   ConfidenceFeatures features;                  // what its confidence came from
 };
 
-/// A result whose confidence is below this is reported as doubtful.
-constexpr double kDoubtfulBelow = 0.5;
+/// A result is trusted when its confidence, its estimated probability of
+/// being right, is at least this, and doubtful below it: a wrong answer
+/// trusted once in twenty is the most a map can take, and the ladder tries
+/// its next rung until an answer reaches it.
+constexpr double kTrustedFrom = 0.95;
 
 /// Result of registering one pair. Frame convention: `transform` is
 /// T_target_source, so p_target = transform * p_source (metres, radians).
@@ -99,7 +102,7 @@ struct RegistrationResult {
   /// Estimated probability, in [0,1], that `transform` is within the success
   /// thresholds (2 degrees, and a few refinement voxels).
   double confidence = 0.0;
-  bool doubtful = false;            // confidence < kDoubtfulBelow
+  bool doubtful = false;            // confidence < kTrustedFrom
   ConfidenceFeatures features;      // what confidence was computed from
   double gp_mean = 0.0;             // GP posterior mean at the optimum (last stage), metres
   double gp_std = 0.0;              // GP posterior standard deviation there, metres

@@ -158,7 +158,7 @@ struct BoIcpConfig {
   BayesOptOptions bo = RegistrationBayesOptOptions();
 
   // --- Checking the answer ---------------------------------------------------
-  // A doubtful first answer (confidence < kDoubtfulBelow) is tried again:
+  // A doubtful first answer (confidence < kTrustedFrom) is tried again:
   // first the search's 8 best distinct ends (instead of refine_candidates)
   // are compared at the finest level; if the answer is still doubtful, one
   // more search runs in 6 DOF (a nested search commits to one rotation
@@ -166,6 +166,11 @@ struct BoIcpConfig {
   // The extra budget is those refinements and one search of the same N_r
   // and N. The better fit at the same finest level is kept.
   bool retry_when_doubtful = true;
+  // Budget::kAuto: whether a doubtful answer goes on past the short search
+  // to the full search and the retry. A loop candidate does not: the chain
+  // puts it within reach of its prior, and the candidates the first rungs
+  // cannot confirm are the ones that cost the full ladder.
+  bool full_search_when_doubtful = true;
   // Search voxel of the retry, metres; 0 = voxel. Automatic settings make it
   // coarser than the first search's: a smoother objective with wider basins,
   // which finds the pairs (low overlap, large turns) a fine one misses.

@@ -35,21 +35,22 @@ int FeatureStep(size_t search_points);
 double FeatureVoxel(double search_voxel, int step);
 
 /// `search_level` (a scan's points at `search_voxel`) downsampled at
-/// FeatureVoxel(search_voxel, step), with its normals and FPFH. Does not
+/// FeatureVoxel(search_voxel, step), with its normals (facing `viewpoint`,
+/// the sensor in the search level's frame, metres) and FPFH. Does not
 /// depend on `threads` (>= 1).
 ScanFeatures ComputeScanFeatures(const Points& search_level, double search_voxel, int step,
-                                 int threads);
+                                 int threads, const Point& viewpoint = Point::Zero());
 
 /// One scan's ScanFeatures at every step asked of it, each computed once.
 /// Safe to call from several threads: a second caller of a step waits for
 /// the first, callers of other steps do not.
 class ScanFeatureMemo {
  public:
-  /// ComputeScanFeatures(search_level, search_voxel, step, threads) the
-  /// first time `step` is asked for; every caller must pass the same scan's
-  /// search level at the same voxel.
+  /// ComputeScanFeatures(search_level, search_voxel, step, threads,
+  /// viewpoint) the first time `step` is asked for; every caller must pass
+  /// the same scan's search level at the same voxel, seen from the same viewpoint.
   std::shared_ptr<const ScanFeatures> At(const Points& search_level, double search_voxel, int step,
-                                         int threads);
+                                         int threads, const Point& viewpoint = Point::Zero());
 
   /// How many steps have been computed.
   size_t computed() const;

@@ -47,8 +47,9 @@ struct RequestedSettings {
   std::optional<double> resolution;                                 // leaf size, metres
   std::optional<double> max_range;                                  // ray cut, metres; 0 = no limit
   std::optional<double> prob_hit, prob_miss, clamp_min, clamp_max;  // sensor model
-  std::optional<double> cloud_voxel;  // merged PLY voxel, metres; 0 = resolution
-  std::string loops = "auto";         // auto | off: loop closures found by the map itself
+  std::optional<double> cloud_voxel;          // merged PLY voxel, metres; 0 = resolution
+  std::string loops = "auto";                 // auto | off: loop closures found by the map itself
+  std::string untrusted_scans = "leave-out";  // leave-out | place: scans with no trusted pair
 };
 
 /// The preset with every given registration setting applied (a given
