@@ -629,6 +629,7 @@ TEST_F(MapCli, ADoubtfulScanIsBridgedNamedAndLeftOut) {
   EXPECT_THAT(r.err, HasSubstr("1 scan has no trusted pair; left out of the map "
                                "(--untrusted-scans place fuses them): scan003.xyz"));
   EXPECT_THAT(r.err, HasSubstr("2 of 2 doubtful chain pairs bridged by a trusted pair over them"));
+  EXPECT_THAT(r.err, HasSubstr("done (7/7)")) << "the bridges are counted on from the chain's 5";
 
   std::map<std::string, json> bridges;
   for (const json& pair : json::parse(Slurp(out / "pairs.json"))) {

@@ -44,12 +44,20 @@ std::vector<Point> ViewCentres(const std::vector<ScanSource>& scans,
   return centres;
 }
 
-// A later stage's progress: only the pairs it registers are new.
+// A later stage's progress: only the pairs it registers are new, and they
+// are counted on from the `before` pairs reported by the stages before it.
 class StageProgress : public MapProgressSink {
  public:
-  explicit StageProgress(MapProgressSink& inner) : inner_(inner) {}
+  StageProgress(MapProgressSink& inner, int before) : inner_(inner), before_(before) {}
   void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
-    if (!reused) inner_.PairFinished(pair, reused, counts);
+    if (reused) {
+      ++reused_;
+      return;
+    }
+    PairCounts continued = counts;
+    continued.done = before_ + counts.done - reused_;
+    continued.total = before_ + counts.total - reused_;
+    inner_.PairFinished(pair, reused, continued);
   }
   void PairFailed(const PairIndex& pair, const std::string& message) override {
     inner_.PairFailed(pair, message);
@@ -58,6 +66,8 @@ class StageProgress : public MapProgressSink {
 
  private:
   MapProgressSink& inner_;
+  int before_ = 0;
+  int reused_ = 0;
 };
 
 bool IsTrusted(const PairResult& result) { return result.confidence >= kTrustedFrom; }
@@ -113,7 +123,6 @@ void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairSto
   const int num_scans = static_cast<int>(batch.scans.size());
   std::set<std::pair<int, int>> registered_already;
   for (const auto& entry : registered.finished) registered_already.insert(Unordered(entry.first));
-  StageProgress bridge_progress(progress);
   for (const BridgeOffset& offset : kBridgeOffsets) {
     std::vector<PairIndex> open;
     for (const PairIndex& link : registered.chain) {
@@ -141,6 +150,7 @@ void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairSto
       bridges.push_back(bridge);
     }
     if (bridges.empty()) continue;
+    StageProgress bridge_progress(progress, static_cast<int>(registered.finished.size()));
     RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan,
                                                  store, bridge_progress, execution);
     for (const PairIndex& p : bridges) {
@@ -193,7 +203,7 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
     loops.push_back(c.pair);
   }
   if (loops.empty()) return;
-  StageProgress loop_progress(progress);
+  StageProgress loop_progress(progress, static_cast<int>(registered.finished.size()));
   RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan, store,
                                                loop_progress, execution);
   for (const PairIndex& p : loops) registered.finished[p] = std::move(found.finished.at(p));
