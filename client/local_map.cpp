@@ -76,10 +76,7 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
   summary.pairs_doubtful = static_cast<int>(
       std::count_if(listed.begin(), listed.end(), [](const PairResult& r) { return r.doubtful; }));
   for (const PairResult& r : listed) summary.answered_by.push_back(r.answered_by);
-  for (const int scan : map.untrusted_scans) {
-    summary.untrusted_scans.push_back(
-        fs::path(run.batch.scans.at(static_cast<size_t>(scan)).path).filename().string());
-  }
+  summary.untrusted_scans = ScanFileNames(run.batch.scans, map.untrusted_scans);
   summary.untrusted_line =
       UntrustedScansLine(run.batch.scans, map.untrusted_scans, map.untrusted_left_out);
   return summary;
@@ -200,10 +197,7 @@ MapOutputSummary AssembleStoredPairs(const LocalRun& run,
   fs::create_directories(out_dir);
   {
     ThreadPool pool(threads);
-    RegisterBridges(batch, registered, store, progress, LocalExecution(pool));
-    if (batch.map.loops == LoopSearch::kAuto) {
-      RegisterLoopCandidates(batch, registered, store, progress, LocalExecution(pool));
-    }
+    RegisterFoundPairs(batch, registered, store, progress, LocalExecution(pool));
   }
   const AssembledMap map =
       AssembleMap(batch, registered, store, progress, LocalOutputPaths(out_dir));

@@ -29,8 +29,7 @@ struct MapOutputSummary {
   LoopStageSummary loops;         // the loop closures the map looked for itself
   std::string bridges;            // BridgeSummaryLine; empty when none was tried
   int bridges_tried = 0;
-  /// File names of the scans with no trusted pair, and whether they were
-  /// left out of the fusion.
+  /// File names of the scans with no trusted pair (ScansWithoutTrustedPair).
   std::vector<std::string> untrusted_scans;
   std::string untrusted_line;  // UntrustedScansLine
 };

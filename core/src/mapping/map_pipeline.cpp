@@ -210,6 +210,14 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
   registered.loops = std::move(loops);
 }
 
+void RegisterFoundPairs(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
+                        MapProgressSink& progress, const PairExecution& execution) {
+  RegisterBridges(batch, registered, store, progress, execution);
+  if (batch.map.loops == LoopSearch::kAuto) {
+    RegisterLoopCandidates(batch, registered, store, progress, execution);
+  }
+}
+
 LoopStageSummary SummariseLoops(const RegisteredPairs& registered,
                                 const std::vector<PairIndex>& in_graph) {
   const std::set<PairIndex> used(in_graph.begin(), in_graph.end());
@@ -297,10 +305,7 @@ MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapPro
   MapPipelineResult result;
   result.pairs = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, batch.plan, store,
                                       progress, execution);
-  RegisterBridges(batch, result.pairs, store, progress, execution);
-  if (batch.map.loops == LoopSearch::kAuto) {
-    RegisterLoopCandidates(batch, result.pairs, store, progress, execution);
-  }
+  RegisterFoundPairs(batch, result.pairs, store, progress, execution);
   result.map =
       AssembleMap(batch, result.pairs, store, progress, outputs, execution.stop_requested, hooks);
   return result;

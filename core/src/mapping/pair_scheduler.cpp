@@ -53,11 +53,12 @@ bool PlanUses(const PairingPlan& plan, const PairIndex& pair) {
   return plan.keyframes ? pair.source > pair.target : listed(plan.chain);
 }
 
-// Why `result`'s pair ran, as the plan says (PairResult::kind).
+// A pair found on the chained poses that is no bridge.
 bool IsLoopCandidate(const PairingPlan& plan, const PairIndex& pair) {
   return plan.bridges.count(pair) == 0 && plan.chained_priors.count(pair) != 0;
 }
 
+// Why `result`'s pair ran, as the plan says (PairResult::kind).
 void MarkKind(const PairingPlan& plan, PairResult& result) {
   const bool extra =
       std::find(plan.extras.begin(), plan.extras.end(), result.pair) != plan.extras.end();

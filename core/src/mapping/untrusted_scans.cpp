@@ -32,6 +32,15 @@ std::vector<int> ScansWithoutTrustedPair(int num_scans,
   return scans;
 }
 
+std::vector<std::string> ScanFileNames(const std::vector<ScanSource>& all,
+                                       const std::vector<int>& scans) {
+  std::vector<std::string> names;
+  for (const int scan : scans) {
+    names.push_back(std::filesystem::path(all.at(static_cast<size_t>(scan)).path).filename());
+  }
+  return names;
+}
+
 std::string UntrustedScansLine(const std::vector<ScanSource>& all, const std::vector<int>& scans,
                                bool left_out) {
   if (scans.empty()) return "";
@@ -39,10 +48,8 @@ std::string UntrustedScansLine(const std::vector<ScanSource>& all, const std::ve
                      (scans.size() == 1 ? " scan has" : " scans have") + " no trusted pair; " +
                      (left_out ? "left out of the map (--untrusted-scans place fuses them): "
                                : "placed by the best doubtful pair: ");
-  for (size_t k = 0; k < scans.size(); ++k) {
-    if (k > 0) line += ", ";
-    line += std::filesystem::path(all.at(static_cast<size_t>(scans[k])).path).filename().string();
-  }
+  const std::vector<std::string> names = ScanFileNames(all, scans);
+  for (size_t k = 0; k < names.size(); ++k) line += (k > 0 ? ", " : "") + names[k];
   return line;
 }
 

@@ -58,6 +58,11 @@ std::string BridgeSummaryLine(const RegisteredPairs& registered);
 void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
                             MapProgressSink& progress, const PairExecution& execution);
 
+/// The stages after the plan's own pairs: RegisterBridges, then
+/// RegisterLoopCandidates when batch.map.loops is kAuto.
+void RegisterFoundPairs(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
+                        MapProgressSink& progress, const PairExecution& execution);
+
 /// What the loop stage found and what it cost.
 struct LoopStageSummary {
   int candidates = 0;          // registered.loops
@@ -115,9 +120,8 @@ struct MapPipelineResult {
   AssembledMap map;
 };
 
-/// The whole pipeline: RegisterPlannedPairs, RegisterBridges, RegisterLoopCandidates when
-/// batch.map.loops is kAuto, then AssembleMap (with the execution's
-/// stop_requested). Throws what any of them throws.
+/// The whole pipeline: RegisterPlannedPairs, RegisterFoundPairs, then AssembleMap (with the
+/// execution's stop_requested). Throws what any of them throws.
 MapPipelineResult RunMapPipeline(const MapBatch& batch, PairStore& store, MapProgressSink& progress,
                                  const PairExecution& execution, const MapOutputPaths& outputs,
                                  const MapPipelineHooks& hooks = {});

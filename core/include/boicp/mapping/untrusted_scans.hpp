@@ -30,6 +30,10 @@ std::vector<int> ScansWithoutTrustedPair(int num_scans,
                                          const std::vector<PairConstraint>& constraints,
                                          const std::vector<bool>& used);
 
+/// The file name (no folder) of each of `scans`, indices into `all`.
+std::vector<std::string> ScanFileNames(const std::vector<ScanSource>& all,
+                                       const std::vector<int>& scans);
+
 /// "2 scans have no trusted pair; left out of the map (--untrusted-scans
 /// place fuses them): a.pcd, b.pcd", naming each by its file name; empty
 /// when `scans` is empty.
