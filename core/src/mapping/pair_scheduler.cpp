@@ -53,17 +53,12 @@ bool PlanUses(const PairingPlan& plan, const PairIndex& pair) {
   return plan.keyframes ? pair.source > pair.target : listed(plan.chain);
 }
 
-// A pair found on the chained poses that is no bridge.
-bool IsLoopCandidate(const PairingPlan& plan, const PairIndex& pair) {
-  return plan.bridges.count(pair) == 0 && plan.chained_priors.count(pair) != 0;
-}
-
 // Why `result`'s pair ran, as the plan says (PairResult::kind).
 void MarkKind(const PairingPlan& plan, PairResult& result) {
   const bool extra =
       std::find(plan.extras.begin(), plan.extras.end(), result.pair) != plan.extras.end();
   const bool bridge = plan.bridges.count(result.pair) != 0;
-  const bool loop = IsLoopCandidate(plan, result.pair);
+  const bool loop = !bridge && plan.chained_priors.count(result.pair) != 0;
   result.kind = bridge ? "bridge" : loop ? "loop" : extra ? "extra" : "chain";
   result.found_by = loop ? "poses" : "";
 }
@@ -307,7 +302,7 @@ class PairScheduler {
         ScaledPreparation::Level& level = preparation_.For(pair);
         const auto prior = plan_.chained_priors.find(pair);
         BoIcpConfig config = level.config;
-        config.full_search_when_doubtful = !IsLoopCandidate(plan_, pair);
+        config.full_search_when_doubtful = prior == plan_.chained_priors.end();
         PairResult result = RegisterBatchPair(scans_, pair, config, *level.prepared, stop,
                                               prior != plan_.chained_priors.end()
                                                   ? std::optional<Transform>(prior->second)

@@ -33,7 +33,7 @@ GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& regi
 /// is doubtful, the scans around it are registered directly, one scan back
 /// (low - 1 onto high), then one scan on (low onto high + 1), then both,
 /// each round only over chain pairs no trusted bridge spans yet, with the
-/// chain's relative pose as the prior. Bridges are stored in `store` and
+/// chain's relative pose as the prior and up to the short search. Bridges are stored in `store` and
 /// added to registered.finished and registered.bridges; a trusted one is an
 /// edge that the chain prefers to the doubtful pair. Throws what
 /// RegisterPlannedPairs throws.

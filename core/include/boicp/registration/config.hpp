@@ -167,9 +167,10 @@ struct BoIcpConfig {
   // and N. The better fit at the same finest level is kept.
   bool retry_when_doubtful = true;
   // Budget::kAuto: whether a doubtful answer goes on past the short search
-  // to the full search and the retry. A loop candidate does not: the chain
-  // puts it within reach of its prior, and the candidates the first rungs
-  // cannot confirm are the ones that cost the full ladder.
+  // to the full search and the retry. A bridge or loop candidate does not:
+  // the chain puts it within reach of its prior, and on the shared drives
+  // every one trusted was answered by the prior or feature rung, while the
+  // untrusted ones cost the whole ladder.
   bool full_search_when_doubtful = true;
   // Search voxel of the retry, metres; 0 = voxel. Automatic settings make it
   // coarser than the first search's: a smoother objective with wider basins,
