@@ -29,11 +29,11 @@ std::string Text(const std::string& value) {
 }
 
 std::string Features(const std::optional<ConfidenceFeatures>& f) {
-  if (!f) return ",,,,,,,";
+  if (!f) return ",,,,,,,,";
   return Number(f->fitness) + ',' + Number(f->rmse_ratio) + ',' + Number(f->margin) + ',' +
          Number(f->support) + ',' + Number(f->probability_better) + ',' +
          Number(f->resolution_deg) + ',' + Number(f->seen_through) + ',' +
-         (f->margin_measured ? '1' : '0');
+         (f->margin_measured ? '1' : '0') + ',' + Number(f->constrained_share);
 }
 
 }  // namespace
@@ -43,7 +43,8 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
   out << "experiment,dataset,source,target,method,threads,seed,perturb,voxel,iterations,"
          "source_points,target_points,evaluations,wall_s,rot_err_deg,trans_err_m,mean_p2p_m,"
          "overlap,success,confidence,icp_s,model_s,attempts,retry_s,fitness,rmse_ratio,margin,"
-         "support,probability_better,resolution_deg,seen_through,margin_measured,answered_by,"
+         "support,probability_better,resolution_deg,seen_through,margin_measured,constrained_share,"
+         "answered_by,"
          "error\n";
   for (const ResultRow& r : rows) {
     out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ',' << Text(r.target)
@@ -62,7 +63,8 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
 std::string FormatAttemptsCsv(const std::vector<ResultRow>& rows) {
   std::ostringstream out;
   out << "experiment,dataset,source,target,method,attempt,kind,mode,fitness,rmse_ratio,margin,"
-         "support,probability_better,resolution_deg,seen_through,margin_measured,confidence,"
+         "support,probability_better,resolution_deg,seen_through,margin_measured,constrained_share,"
+         "confidence,"
          "success,kept\n";
   for (const ResultRow& r : rows) {
     for (size_t k = 0; k < r.attempt_rows.size(); ++k) {

@@ -1,5 +1,6 @@
 #include "json_output.hpp"
 
+#include "boicp/settings/pair_result_json.hpp"
 #include "boicp/settings/settings_json.hpp"
 
 namespace boicp::cli {
@@ -26,6 +27,16 @@ nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts) {
   return out;
 }
 
+namespace {
+
+nlohmann::json UnconstrainedToJson(const std::vector<FreeSlide>& slides) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const FreeSlide& slide : slides) out.push_back(settings::FreeSlideToJson(slide));
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json RegistrationToJson(const RegistrationResult& r,
                                   const std::vector<std::string>& auto_fields) {
   return {{"transform", TransformToJson(r.transform)},
@@ -36,6 +47,8 @@ nlohmann::json RegistrationToJson(const RegistrationResult& r,
           {"search_reach", r.search_reach},
           {"confidence", r.confidence},
           {"seen_through", r.features.seen_through},
+          {"constrained_share", r.features.constrained_share},
+          {"unconstrained", UnconstrainedToJson(r.unconstrained)},
           {"doubtful", r.doubtful},
           {"attempts", AttemptsToJson(r.attempts)},
           {"answered_by", RungName(r.answered_by)},

@@ -71,7 +71,8 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
 // keys added since: they read as trusted (no doubtful flag, PairResult's
 // confidence), unknown (overlap, search_reach), the full search
 // (answered_by, as every pair was before the ladder) and the settings under
-// today's names. Files of a later format are refused, not misread.
+// today's names. Files of format 1 predate the unconstrained directions:
+// not measured (null). Files of a later format are refused, not misread.
 void MigratePairFile(json& j, const std::string& path) {
   const int format = j.value("format", 0);
   if (format > kPairFileFormat) {
@@ -80,15 +81,18 @@ void MigratePairFile(json& j, const std::string& path) {
                              "); use the boicp that wrote it");
   }
   if (format == kPairFileFormat) return;
-  if (!j.contains("doubtful")) {
-    j["doubtful"] = false;
-    j["confidence"] = 1.0;
+  if (format == 0) {
+    if (!j.contains("doubtful")) {
+      j["doubtful"] = false;
+      j["confidence"] = 1.0;
+    }
+    for (const char* key : {"overlap", "search_reach"}) {
+      if (!j.contains(key)) j[key] = nullptr;
+    }
+    if (!j.contains("answered_by")) j["answered_by"] = RungName(Rung::kFullSearch);
+    UpgradeOldPairConfig(j.at("settings").at("config"), path);
   }
-  for (const char* key : {"overlap", "search_reach"}) {
-    if (!j.contains(key)) j[key] = nullptr;
-  }
-  if (!j.contains("answered_by")) j["answered_by"] = RungName(Rung::kFullSearch);
-  UpgradeOldPairConfig(j.at("settings").at("config"), path);
+  if (!j.contains("unconstrained")) j["unconstrained"] = nullptr;
   j["format"] = kPairFileFormat;
 }
 

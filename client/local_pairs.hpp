@@ -21,7 +21,7 @@ nlohmann::json PairSettings(const std::vector<ScanSource>& scans, const PairInde
 
 /// The format every pair file is written in ("format"); files without one
 /// are read through a migration (ReadPairFile).
-constexpr int kPairFileFormat = 1;
+constexpr int kPairFileFormat = 2;
 
 /// A pair file of a format newer than kPairFileFormat: kept, never
 /// overwritten, and reported.

@@ -27,6 +27,11 @@ json ValueToJson(const T& value) {
     return value ? json(*value) : json(nullptr);
   } else if constexpr (std::is_same_v<T, Rung>) {
     return RungName(value);
+  } else if constexpr (std::is_same_v<T, std::optional<std::vector<FreeSlide>>>) {
+    if (!value) return json(nullptr);
+    json slides = json::array();
+    for (const FreeSlide& slide : *value) slides.push_back(FreeSlideToJson(slide));
+    return slides;
   } else {
     return value;
   }
@@ -54,12 +59,34 @@ T ValueFromJson(const json& value) {
     const std::optional<Rung> rung = RungFromName(name);
     if (!rung) throw InputError("unknown rung '" + name + "'");
     return *rung;
+  } else if constexpr (std::is_same_v<T, std::optional<std::vector<FreeSlide>>>) {
+    if (value.is_null()) return std::nullopt;
+    if (!value.is_array()) throw InputError("expected a list of slides");
+    std::vector<FreeSlide> slides;
+    for (const json& slide : value) slides.push_back(FreeSlideFromJson(slide));
+    return slides;
   } else {
     return value.get<T>();
   }
 }
 
 }  // namespace
+
+json FreeSlideToJson(const FreeSlide& slide) {
+  return {{"axis", {slide.axis.x(), slide.axis.y(), slide.axis.z()}},
+          {"extent_m", slide.extent},
+          {"across_share", slide.across_share}};
+}
+
+FreeSlide FreeSlideFromJson(const json& in) {
+  const json& axis = in.at("axis");
+  if (!axis.is_array() || axis.size() != 3) throw InputError("an axis is 3 numbers");
+  FreeSlide slide;
+  slide.axis = {axis[0].get<double>(), axis[1].get<double>(), axis[2].get<double>()};
+  slide.extent = in.at("extent_m").get<double>();
+  slide.across_share = in.at("across_share").get<double>();
+  return slide;
+}
 
 json PairResultToJson(const PairResult& result, PairResultFormat format) {
   json out = {{"source", result.pair.source}, {"target", result.pair.target}};

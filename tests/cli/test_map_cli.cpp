@@ -160,6 +160,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
     ASSERT_TRUE(p.contains("doubtful") && p["doubtful"].is_boolean()) << p.dump();
     ASSERT_TRUE(p.contains("overlap") && p["overlap"].is_number()) << p.dump();
     ASSERT_TRUE(p.contains("search_reach") && p["search_reach"].is_number()) << p.dump();
+    ASSERT_TRUE(p.contains("unconstrained") && p["unconstrained"].is_array()) << p.dump();
     EXPECT_EQ(p["doubtful"].get<bool>(), p["confidence"].get<double>() < kTrustedFrom);
     EXPECT_GT(p["overlap"].get<double>(), 0.0);
     doubtful += p["doubtful"].get<bool>();
@@ -179,7 +180,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   // load as trusted, overlap and reach unknown, answered by the full search;
   // a file marked doubtful is counted as such.
   for (const char* name : {"000000-000001.json", "000001-000002.json"}) {
-    EXPECT_EQ(json::parse(Slurp(out / "pairs" / name))["format"], 1);
+    EXPECT_EQ(json::parse(Slurp(out / "pairs" / name))["format"], 2);
     EditPairFile(out / "pairs" / name, [](json& j) {
       j.erase("format");
       j.erase("doubtful");
@@ -188,7 +189,10 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
       j.erase("answered_by");
     });
   }
+  // A file of format 1 predates the unconstrained directions: unknown.
   EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) {
+    j["format"] = 1;
+    j.erase("unconstrained");
     j["doubtful"] = true;
     j["confidence"] = 0.1;
   });
@@ -206,6 +210,7 @@ TEST_F(MapCli, DoubtfulPairsAreMarkedAndOldPairFilesStillLoad) {
   EXPECT_EQ(pairs[0]["answered_by"], "full-search");
   EXPECT_EQ(pairs[1]["answered_by"], "full-search");
   EXPECT_EQ(pairs[2]["doubtful"], true);
+  EXPECT_TRUE(pairs[2]["unconstrained"].is_null());
   EXPECT_THAT(again.err, HasSubstr("\n" + RungLine(pairs) + "\n")) << again.err;
   EXPECT_THAT(RungLine(pairs), HasSubstr("full")) << again.err;
 }
@@ -264,12 +269,12 @@ TEST_F(MapCli, PairFilesOfTheOlderSettingsFormatAreReused) {
   EXPECT_TRUE(redone["settings"]["config"].contains("no_retry")) << "not registered again";
 
   // A file of a format newer than this boicp reads is refused, not misread.
-  EXPECT_EQ(redone["format"], 1);
-  EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) { j["format"] = 2; });
+  EXPECT_EQ(redone["format"], 2);
+  EditPairFile(out / "pairs" / "000002-000003.json", [](json& j) { j["format"] = 3; });
   const RunResult newer = Run(args);
   EXPECT_EQ(newer.exit_code, 2) << newer.err;
   EXPECT_THAT(newer.err, HasSubstr("000002-000003.json"));
-  EXPECT_THAT(newer.err, HasSubstr("format 2 is newer than this boicp reads (1)"));
+  EXPECT_THAT(newer.err, HasSubstr("format 3 is newer than this boicp reads (2)"));
 }
 
 TEST_F(MapCli, GeneratedDriveWritesEveryOutputAndRerunsReusePairs) {

@@ -122,6 +122,8 @@ TEST_F(Cli, RegisterDemoPairPrintsOneJsonObjectNearTheTruth) {
   // The answer lies inside its search box.
   EXPECT_GE(j["search_reach"].get<double>(), 0.0);
   EXPECT_LE(j["search_reach"].get<double>(), 1.0);
+  EXPECT_TRUE(j["unconstrained"].is_array());
+  EXPECT_GT(j["constrained_share"].get<double>(), 0.0);
   // Some rung of the ladder answered: one attempt kept.
   EXPECT_EQ(kRungs.count(j["answered_by"].get<std::string>()), 1u) << j["answered_by"];
   ASSERT_GE(j["attempts"].size(), 1u);

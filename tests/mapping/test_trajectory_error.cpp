@@ -65,10 +65,17 @@ TEST(CompareTrajectories, SkipsScansWithoutAReferenceAndRefusesTooFew) {
   EXPECT_EQ(error.scans, 20);
   EXPECT_TRUE(std::isnan(error.per_scan[3]));
   EXPECT_THROW(CompareTrajectories(poses, {reference.begin(), reference.begin() + 2}), InputError);
-  std::vector<std::optional<Transform>> two(21);
-  two[0] = Transform::Identity();
-  two[1] = Transform::Identity();
-  EXPECT_THROW(CompareTrajectories(poses, two), InputError);
+  std::vector<std::optional<Transform>> one(21);
+  one[0] = Transform::Identity();
+  EXPECT_THROW(CompareTrajectories(poses, one), InputError);
+
+  // Two scans align rigidly: a moved copy has no error, a longer step has.
+  const std::vector<std::optional<Transform>> pair = {reference[0], reference[4]};
+  const Transform frame = PoseFromYawTranslation(0.7, {5.0, 2.0, 0.0});
+  EXPECT_LT(CompareTrajectories({frame * *pair[0], frame * *pair[1]}, pair).ate_rmse, 1e-9);
+  Transform longer = *pair[1];
+  longer(0, 3) += 1.0;
+  EXPECT_NEAR(CompareTrajectories({*pair[0], longer}, pair).ate_rmse, 0.5, 1e-9);
 }
 
 }  // namespace

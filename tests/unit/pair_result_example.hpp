@@ -28,6 +28,8 @@ inline PairResult ExamplePairResult() {
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < 6; ++j) r.information(i, j) = 10.0 * i + j + 0.5;
   }
+  r.unconstrained = std::vector<FreeSlide>{{Eigen::Vector3d(0.6, 0.8, 0.0), 0.004, 2.5},
+                                           {Eigen::Vector3d(0.0, 0.0, 1.0), 0.001, 0.75}};
   r.in_graph = false;
   r.finished_at = 1764931200.25;
   return r;

@@ -145,5 +145,26 @@ TEST(Confidence, AnAnswerSeenThroughIsDoubtfulWhateverItsFit) {
   EXPECT_LT(Confidence(SeenThrough(bunny, 0.381)), kTrustedFrom);
 }
 
+// An answer free to slide or turn (a corridor, a floor) is doubtful whatever
+// its fit and margin; one that holds its weakest direction loses nothing.
+TEST(Confidence, AnAnswerFreeAlongSomeDirectionIsDoubtful) {
+  for (const ConfidenceFeatures& held :
+       {Features(0.9, 1.0, 0.1), Features(0.5, 0.6, 0.3), Features(0.3, 0.2, 0.5)}) {
+    ConfidenceFeatures f = held;
+    f.constrained_share = 0.03;
+    EXPECT_EQ(Confidence(f), Confidence(held));
+    double previous = Confidence(f);
+    for (double share = 0.03; share >= 0.0; share -= 0.001) {
+      f.constrained_share = share;
+      EXPECT_LE(Confidence(f), previous) << share;
+      previous = Confidence(f);
+    }
+    f.constrained_share = 0.5 * kUnconstrainedShare;
+    EXPECT_EQ(Confidence(f), 0.0);
+    f.constrained_share = 0.99 * kUnconstrainedShare;  // any unconstrained direction
+    EXPECT_LT(Confidence(f), kTrustedFrom);
+  }
+}
+
 }  // namespace
 }  // namespace boicp

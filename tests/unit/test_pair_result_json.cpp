@@ -26,6 +26,20 @@ TEST(PairResultJson, EachFormatRoundTripsItsFieldsExactly) {
   EXPECT_EQ(read.information, r.information);
   EXPECT_EQ(read.seed, r.seed);
   EXPECT_EQ(read.answered_by, Rung::kShortSearch);
+  ASSERT_TRUE(read.unconstrained.has_value());
+  ASSERT_EQ(read.unconstrained->size(), 2u);
+  EXPECT_EQ((*read.unconstrained)[1].extent, 0.75);
+}
+
+TEST(PairResultJson, FreeSlidesNameTheirAxisExtentAndShare) {
+  const json listing = PairResultToJson(ExamplePairResult(), kPairListing);
+  const json& slide = listing["unconstrained"][0];
+  EXPECT_EQ(slide["axis"], json({0.6, 0.8, 0.0}));
+  EXPECT_EQ(slide["extent_m"], 2.5);
+  EXPECT_EQ(slide["across_share"], 0.004);
+  json bad = slide;
+  bad["axis"] = json({1.0, 0.0});
+  EXPECT_THROW(FreeSlideFromJson(bad), InputError);
 }
 
 TEST(PairResultJson, EachFormatCarriesItsOwnFields) {
@@ -51,12 +65,15 @@ TEST(PairResultJson, UnknownValuesAreNullBothWays) {
   PairResult r = ExamplePairResult();
   r.overlap.reset();
   r.search_reach.reset();
+  r.unconstrained.reset();
   const json j = PairResultToJson(r, kPairListing);
+  EXPECT_TRUE(j["unconstrained"].is_null());
   EXPECT_TRUE(j["overlap"].is_null());
   EXPECT_TRUE(j["search_reach"].is_null());
   const PairResult read = PairResultFromJson(j, kPairListing);
   EXPECT_FALSE(read.overlap.has_value());
   EXPECT_FALSE(read.search_reach.has_value());
+  EXPECT_FALSE(read.unconstrained.has_value());
 }
 
 TEST(PairResultJson, AMissingOrMalformedKeyIsNamed) {

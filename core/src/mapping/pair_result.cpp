@@ -20,6 +20,7 @@ PairResult MakePairResult(const PairIndex& pair, const RegistrationResult& regis
   out.runtime_s = r.runtime_s;
   out.seed = seed;
   out.information = r.information;
+  out.unconstrained = r.unconstrained;
   return out;
 }
 
@@ -49,6 +50,7 @@ const std::vector<PairResultField>& PairResultFields() {
       {"seed", &PairResult::seed, kEverywhere},
       // The daemon keeps the information matrix beside the API's message.
       {"information", &PairResult::information, kPairFile},
+      {"unconstrained", &PairResult::unconstrained, kPairFile | kPairListing},
       // A pair file is written as its pair finishes, before the graph is known.
       {"in_graph", &PairResult::in_graph, kPairListing | kPairApi},
       // The plan says why each pair ran, when the pipeline lists it.

@@ -39,7 +39,9 @@ TrajectoryError CompareTrajectories(const std::vector<Transform>& poses,
   for (size_t i = 0; i < reference.size(); ++i) {
     if (reference[i]) known.push_back(i);
   }
-  if (known.size() < 3) throw InputError("trajectory error: fewer than 3 scans have a reference");
+  // Two positions align rigidly up to a turn about the line through them,
+  // which moves neither.
+  if (known.size() < 2) throw InputError("trajectory error: fewer than 2 scans have a reference");
 
   TrajectoryError error;
   error.scans = static_cast<int>(known.size());

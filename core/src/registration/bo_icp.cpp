@@ -154,6 +154,10 @@ std::vector<Transform> FeatureGuesses(const ScanPyramid& source_scan,
   return guesses;
 }
 
+// What an answer of scans that do not overlap looks like (NoOverlapFound).
+constexpr double kNoOverlapFitness = 0.1;
+constexpr double kNoOverlapSeenThrough = 0.3;
+
 // One answer assessed twice: a rival basin that one rung found stays found,
 // though a later rung's search may not visit it, so the later assessment
 // keeps the smallest margin measured to a rival.
@@ -184,27 +188,30 @@ class Ladder {
         frame_(MakeSearchFrame(*prepared_, prior)) {}
 
   Registered Run(const std::optional<Transform>& guess) {
-    if (const std::optional<Transform> start = prior_ ? prior_ : guess) {
-      if (PriorRung(*start)) return Finish();
-    }
-    if (FeatureRung()) return Finish();
+    const std::optional<Transform> start = prior_ ? prior_ : guess;
+    if (start ? PriorRung(*start) : FeatureRung()) return Finish();
     const PairContext pair = MakePairContext(*prepared_, config_);
     StagedSearch search(pair, frame_, config_, callbacks_);
     if (SearchRung(search, /*short_budget=*/true)) return Finish();
-    if (!config_.full_search_when_doubtful) return Finish();
+    if (!config_.full_search_when_doubtful || NoOverlapFound()) return Finish();
     if (SearchRung(search, /*short_budget=*/false)) return Finish();
     if (config_.retry_when_doubtful) RetryRung();
     return Finish();
   }
 
  private:
-  // The refinement from the prior (or guess), beside probes that look for a
-  // competing basin next to it.
+  // The refinement from the prior (or guess), beside the competing basins
+  // looked for around it (probes) and anywhere (the feature hypotheses): an
+  // ICP from a guess short of the motion can stall in a shallow basin that
+  // every probe falls back into, though a better one lies a few voxels on.
+  // The feature rung is then not run again.
   bool PriorRung(const Transform& start) {
     const auto started = std::chrono::steady_clock::now();
     std::vector<Transform> starts = {start};
     for (const Transform& probe : ProbesAround(start, frame_.source_centroid, config_))
       starts.push_back(probe);
+    learned_ = FeatureGuesses(source_, target_, *prepared_, config_);
+    starts.insert(starts.end(), learned_.begin(), learned_.end());
     SearchOutcome out = OutcomeOf(prepared_, frame_, config_);
     RefineAndAssess(out, starts, config_, callbacks_);
     learned_.push_back(out.refined.transform);
@@ -299,6 +306,16 @@ class Ladder {
     return kept_.confidence >= kTrustedFrom;
   }
 
+  // Every answer so far matched under a tenth of the source and put at least
+  // 30 % of it where the target's sensor saw through (a view the check can
+  // read): the scans do not overlap, as across a throttled log's gap, and
+  // the full search and the retry would find nothing to trust either.
+  bool NoOverlapFound() const {
+    return std::all_of(attempts_.begin(), attempts_.end(), [](const Attempt& a) {
+      return a.fitness < kNoOverlapFitness && a.features.seen_through >= kNoOverlapSeenThrough;
+    });
+  }
+
   Registered Finish() {
     attempts_[kept_index_].kept = true;
     return {std::move(kept_), rung_, std::move(attempts_)};
@@ -384,15 +401,17 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   result.fitness = kept.refined.score.fitness;
   result.inlier_rmse = kept.refined.score.inlier_rmse;
   const PyramidLevel& finest = kept.prepared->pyramid.back();
-  result.information =
-      MovedInformation(PlaneInformation(finest.source, finest.target, kept.refined.transform,
-                                        config.EffectiveInlierDistance(), 3.0 * finest.voxel),
-                       target.centre);
+  const InformationMatrix information =
+      PlaneInformation(finest.source, finest.target, kept.refined.transform,
+                       config.EffectiveInlierDistance(), 3.0 * finest.voxel);
+  result.information = MovedInformation(information, target.centre);
+  result.unconstrained = UnconstrainedSlides(information, config.EffectiveInlierDistance());
   result.overlap = kept.overlap;
   result.search_reach = SearchReach(kept.box, kept.refined.transform);
   result.probability_better = kept.probability_better;
   result.features = kept.features;
-  result.confidence = kept.confidence;
+  result.features.constrained_share = ConstrainedShare(information);
+  result.confidence = std::min(kept.confidence, Confidence(result.features));
   result.doubtful = result.confidence < kTrustedFrom;
   result.gp_mean = kept.gp_mean;
   result.gp_std = kept.gp_std;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "boicp/icp/unconstrained_directions.hpp"
+
 namespace boicp {
 namespace {
 
@@ -38,6 +40,14 @@ constexpr double kFitnessOfFullTrust = 0.1;
 // half round puts a third of its points there (bench/README.md).
 constexpr double kSeenThroughOfFullTrust = 0.15;
 constexpr double kSeenThroughOfNoTrust = 0.3;
+// An answer free to slide along some direction (a corridor, a floor, a
+// wall) is right only by chance along it: trust falls from full just above
+// kUnconstrainedShare (a slide of 10 inlier distances moves the matches off
+// their surfaces by one, on average), so that every answer with an
+// unconstrained slide is doubtful, to none at half that. Right answers of
+// real scans hold their weakest slide more firmly (bench/README.md).
+constexpr double kConstrainedShareOfFullTrust = 1.06 * kUnconstrainedShare;
+constexpr double kConstrainedShareOfNoTrust = 0.5 * kUnconstrainedShare;
 
 }  // namespace
 
@@ -53,8 +63,12 @@ double Confidence(const ConfidenceFeatures& f) {
   const double seen_through_cap = std::clamp(
       (kSeenThroughOfNoTrust - f.seen_through) / (kSeenThroughOfNoTrust - kSeenThroughOfFullTrust),
       0.0, 1.0);
-  return std::min(
-      {model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, tie_cap, seen_through_cap});
+  const double free_slide_cap =
+      std::clamp((f.constrained_share - kConstrainedShareOfNoTrust) /
+                     (kConstrainedShareOfFullTrust - kConstrainedShareOfNoTrust),
+                 0.0, 1.0);
+  return std::min({model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, tie_cap, seen_through_cap,
+                   free_slide_cap});
 }
 
 }  // namespace boicp

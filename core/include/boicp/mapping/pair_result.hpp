@@ -42,6 +42,8 @@ struct PairResult {
   uint64_t seed = 0;  // the pair's own seed, PairSeed(job seed, pair)
   /// How firmly the inliers pin down `transform` (RegistrationResult::information).
   InformationMatrix information = InformationMatrix::Identity();
+  /// RegistrationResult::unconstrained; unknown in results stored before it was measured.
+  std::optional<std::vector<FreeSlide>> unconstrained;
   /// False for a keyframe probe or loop closure the final poses leave out.
   bool in_graph = true;
   /// Why the pair was registered: "chain" (the plan's own pairs, keyframe
@@ -81,7 +83,8 @@ enum PairResultFormat : unsigned {
 using PairResultMember =
     std::variant<Transform PairResult::*, InformationMatrix PairResult::*, double PairResult::*,
                  std::optional<double> PairResult::*, bool PairResult::*, Rung PairResult::*,
-                 int PairResult::*, uint64_t PairResult::*, std::string PairResult::*>;
+                 int PairResult::*, uint64_t PairResult::*, std::string PairResult::*,
+                 std::optional<std::vector<FreeSlide>> PairResult::*>;
 
 struct PairResultField {
   const char* name;  // the JSON key, and the boicp.v1.PairResult field

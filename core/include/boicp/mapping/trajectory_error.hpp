@@ -24,7 +24,7 @@ struct TrajectoryError {
 
 /// Compares `poses` (T_map_scan) with `reference` (T_world_scan, where
 /// known), scan by scan. `segment` metres <= 0: a tenth of the reference
-/// path. Throws InputError when the counts differ or fewer than 3 scans
+/// path. Throws InputError when the counts differ or fewer than 2 scans
 /// have a reference.
 TrajectoryError CompareTrajectories(const std::vector<Transform>& poses,
                                     const std::vector<std::optional<Transform>>& reference,

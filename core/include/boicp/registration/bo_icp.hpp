@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "boicp/icp/pair_information.hpp"
+#include "boicp/icp/unconstrained_directions.hpp"
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/config.hpp"
 #include "boicp/util/types.hpp"
@@ -31,8 +32,9 @@ struct Evaluation {
 /// runs only while the answers before it are doubtful; a fixed budget runs
 /// the full search and the retry only.
 enum class Rung {
-  kPrior,        ///< the refinement from the pair's prior (or a drive's identity guess)
-  kFeatures,     ///< FPFH correspondence hypotheses, refined
+  kPrior,        ///< the refinement from the pair's prior (or a drive's identity guess), beside
+                 ///< probes around it and the feature hypotheses
+  kFeatures,     ///< FPFH correspondence hypotheses, refined (without a prior or guess)
   kShortSearch,  ///< the search, each stage ending once its best basin is confirmed
   kFullSearch,   ///< the same search continued to the preset's full budget
   kRetry,        ///< a 6-DOF search with another seed, seeded with what came before
@@ -90,6 +92,10 @@ struct RegistrationResult {
   /// the refined source points, within inlier_distance): a pose graph's edge
   /// weight, weak along directions the surfaces do not constrain.
   InformationMatrix information = InformationMatrix::Zero();
+  /// The slides those inliers leave free (UnconstrainedSlides),
+  /// axes in the target's frame; an answer with one is doubtful
+  /// (features.constrained_share caps its confidence).
+  std::vector<FreeSlide> unconstrained;
   /// Fraction of the search-voxel source within 1.5 search voxels of the
   /// target: how much of the source the target sees, for keyframe choice.
   double overlap = 0.0;

@@ -8,7 +8,8 @@ namespace boicp {
 
 /// What the engine knows about its own answer when it finishes. The model
 /// weighs fitness, log(margin) and resolution; fitness, a measured margin and
-/// seen_through cap it; the rest is reported for fitting and diagnosis.
+/// seen_through and constrained_share cap it; the rest is reported for
+/// fitting and diagnosis.
 struct ConfidenceFeatures {
   double fitness = 0.0;          // inlier fraction at the finest level, in [0, 1]
   double rmse_ratio = 0.0;       // inlier RMSE / inlier distance, in [0, 1]
@@ -21,13 +22,19 @@ struct ConfidenceFeatures {
   /// its frame's origin, in [0, 1]; 0 when that view covers too few
   /// directions to say (the origin is not where a sensor stood).
   double seen_through = 0.0;
+  /// ConstrainedShare of the answer's matches, in [0, 1]: how firmly its
+  /// least constrained slide is held; 1 where not measured (a
+  /// rung's own attempts: the result measures its answer's).
+  double constrained_share = 1.0;
 };
 
 /// Estimated probability, in [0, 1), that the answer is within the success
 /// thresholds (2 degrees, and a few refinement voxels of translation); 0
 /// with no inliers, under 0.5 with fitness under 0.05, a measured margin
-/// under 0.02 or seen_through over 0.225, and 0 with a measured margin of
-/// 0.01 or less or seen_through of 0.3 or more.
+/// under 0.02 or seen_through over 0.225, under 0.95 with
+/// constrained_share under kUnconstrainedShare (an unconstrained direction),
+/// and 0 with a measured margin of 0.01 or less, seen_through of 0.3 or more
+/// or constrained_share of half kUnconstrainedShare or less.
 double Confidence(const ConfidenceFeatures& features);
 
 }  // namespace boicp

@@ -13,6 +13,12 @@ namespace boicp::settings {
 /// rows, answered_by as RungName's word, an unknown value as null.
 nlohmann::json PairResultToJson(const PairResult& result, PairResultFormat format);
 
+/// {"axis": [x, y, z], "extent_m", "across_share"}.
+nlohmann::json FreeSlideToJson(const FreeSlide& slide);
+
+/// The reverse of FreeSlideToJson. Throws InputError when malformed.
+FreeSlide FreeSlideFromJson(const nlohmann::json& json);
+
 /// The reverse of PairResultToJson. Throws InputError naming the first key
 /// that is missing or malformed.
 PairResult PairResultFromJson(const nlohmann::json& json, PairResultFormat format);

@@ -1,0 +1,125 @@
+// Which slides a pair's matched surfaces leave free, and what that does to
+// the answer's confidence (core/icp/unconstrained_directions).
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "boicp/icp/unconstrained_directions.hpp"
+#include "boicp/io/synthetic_scene.hpp"
+#include "boicp/mapping/pose_graph.hpp"
+#include "boicp/registration/bo_icp.hpp"
+#include "evaluation.hpp"
+
+namespace boicp {
+namespace {
+
+// A plane through `origin` spanned by `u` and `v`, sampled every `step`
+// metres over [0, length_u] x [0, length_v].
+Points Plane(const Point& origin, const Point& u, const Point& v, double length_u, double length_v,
+             double step) {
+  Points out;
+  for (double a = 0.0; a <= length_u; a += step) {
+    for (double b = 0.0; b <= length_v; b += step) out.push_back(origin + a * u + b * v);
+  }
+  return out;
+}
+
+// A corridor along x, 3 m wide and 2.5 m high: a floor and two walls.
+Points Corridor(double length) {
+  const Point x = Point::UnitX(), y = Point::UnitY(), z = Point::UnitZ();
+  Points out = Plane({-length / 2, -1.5, 0.0}, x, y, length, 3.0, 0.1);
+  for (const double side : {-1.5, 1.5}) {
+    for (const Point& p : Plane({-length / 2, side, 0.0}, x, z, length, 2.5, 0.1)) out.push_back(p);
+  }
+  return out;
+}
+
+InformationMatrix SelfInformation(const Points& points) {
+  return PlaneInformation(points, NearestNeighborIndex(points), Transform::Identity(), 0.05, 0.3);
+}
+
+bool HasFreeSlide(const std::vector<FreeSlide>& free, const Point& axis) {
+  return std::any_of(free.begin(), free.end(),
+                     [&](const FreeSlide& s) { return std::abs(s.axis.dot(axis)) > 0.99; });
+}
+
+// A wall leaves its two slides free, at the bound of what can be said; the
+// slide across it is held: one inlier distance off per inlier distance moved.
+TEST(UnconstrainedSlides, AWallLeavesItsTwoSlidesFree) {
+  const InformationMatrix wall =
+      SelfInformation(Plane({5.0, -3.0, -1.0}, Point::UnitY(), Point::UnitZ(), 6.0, 2.0, 0.05));
+  const std::vector<FreeSlide> free = UnconstrainedSlides(wall, 0.05);
+  ASSERT_EQ(free.size(), 2u);
+  EXPECT_TRUE(HasFreeSlide(free, Point::UnitY()));
+  EXPECT_TRUE(HasFreeSlide(free, Point::UnitZ()));
+  for (const FreeSlide& s : free) EXPECT_EQ(s.extent, kFreeSlideBound);
+  EXPECT_LT(ConstrainedShare(wall), 1e-6);
+
+  const std::vector<FreeSlide> all = PrincipalSlides(wall, 0.05);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_GT(std::abs(all[2].axis.x()), 0.99);
+  EXPECT_NEAR(all[2].across_share, 1.0, 1e-6);
+  EXPECT_NEAR(all[2].extent, 0.05, 1e-6);
+}
+
+// A corridor leaves exactly one slide free, along it, and the pose graph's
+// edge barely pulls that way.
+TEST(UnconstrainedSlides, ACorridorLeavesOnlyTheSlideAlongIt) {
+  const InformationMatrix corridor = SelfInformation(Corridor(20.0));
+  const std::vector<FreeSlide> free = UnconstrainedSlides(corridor, 0.05);
+  ASSERT_EQ(free.size(), 1u);
+  EXPECT_GT(std::abs(free[0].axis.x()), 0.99);
+  const std::vector<FreeSlide> all = PrincipalSlides(corridor, 0.05);
+  EXPECT_GT(all[1].across_share, 10 * kUnconstrainedShare);
+
+  const InformationMatrix edge = CalibratedInformation(corridor, 0.02);
+  EXPECT_LT(edge(3, 3), 1e-2 * edge(4, 4));
+  EXPECT_LT(edge(3, 3), 1e-2 * edge(5, 5));
+}
+
+// A street holds every slide, wherever its frame's origin (the answer is
+// measured on centred clouds).
+TEST(UnconstrainedSlides, AStreetHoldsEverySlideWhereverItsOrigin) {
+  const Points street = SimulateScan(MakeSyntheticStreet(3, 10.0),
+                                     PoseFromYawTranslation(0.0, {0.0, 0.0, 1.8}), 20.0, 0.0, 1);
+  const InformationMatrix near = SelfInformation(street);
+  EXPECT_TRUE(UnconstrainedSlides(near, 0.05).empty());
+  EXPECT_GT(ConstrainedShare(near), 5 * kUnconstrainedShare);
+  const InformationMatrix far = MovedInformation(near, Point(300.0, -200.0, 10.0));
+  EXPECT_NEAR(ConstrainedShare(far), ConstrainedShare(near), 1e-9);
+}
+
+// No matches: nothing to say, and nothing held.
+TEST(UnconstrainedSlides, NoMatchesNoSlides) {
+  EXPECT_TRUE(PrincipalSlides(InformationMatrix::Zero(), 0.05).empty());
+  EXPECT_EQ(ConstrainedShare(InformationMatrix::Zero()), 0.0);
+}
+
+// A corridor scan slid along itself fits as well wherever it stops: the
+// answer is doubtful, and says which way it is free.
+TEST(UnconstrainedSlides, ACorridorPairIsDoubtfulAndNamesItsFreeSlide) {
+  const Points target = Corridor(30.0);
+  Points source;
+  for (const Point& p : target) {
+    if (std::abs(p.x()) < 10.0) source.push_back(p - Point(0.7, 0.0, 0.0));
+  }
+  BoIcpConfig config = PresetConfig("A");
+  config.automatic.clear();
+  config.voxel = 0.2;
+  config.refine_voxel = 0.05;
+  config.seed = 4;
+  const RegistrationResult result =
+      RegisterPair(source, target, config, std::nullopt, {}, Transform::Identity());
+  EXPECT_TRUE(result.doubtful) << result.confidence;
+  EXPECT_LT(result.features.constrained_share, kUnconstrainedShare);
+  EXPECT_TRUE(HasFreeSlide(result.unconstrained, Point::UnitX()));
+  // The directions it does hold are right: across the corridor and up.
+  const Transform truth = PoseFromYawTranslation(0.0, {0.7, 0.0, 0.0});
+  EXPECT_LT(RotationErrorDeg(result.transform, truth), 1.0);
+  EXPECT_LT(std::abs(result.transform(1, 3)), 0.05);
+  EXPECT_LT(std::abs(result.transform(2, 3)), 0.05);
+}
+
+}  // namespace
+}  // namespace boicp
