@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "boicp/icp/unconstrained_directions.hpp"
+#include "boicp/icp/unconstrained_slides.hpp"
 
 namespace boicp {
 namespace {

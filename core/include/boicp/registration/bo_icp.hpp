@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "boicp/icp/pair_information.hpp"
-#include "boicp/icp/unconstrained_directions.hpp"
+#include "boicp/icp/unconstrained_slides.hpp"
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/config.hpp"
 #include "boicp/util/types.hpp"

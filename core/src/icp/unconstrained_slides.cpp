@@ -1,4 +1,4 @@
-#include "boicp/icp/unconstrained_directions.hpp"
+#include "boicp/icp/unconstrained_slides.hpp"
 
 #include <algorithm>
 #include <cmath>

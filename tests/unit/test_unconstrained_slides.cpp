@@ -1,11 +1,11 @@
 // Which slides a pair's matched surfaces leave free, and what that does to
-// the answer's confidence (core/icp/unconstrained_directions).
+// the answer's confidence (core/icp/unconstrained_slides).
 
 #include <algorithm>
 
 #include <gtest/gtest.h>
 
-#include "boicp/icp/unconstrained_directions.hpp"
+#include "boicp/icp/unconstrained_slides.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/mapping/pose_graph.hpp"
 #include "boicp/registration/bo_icp.hpp"
