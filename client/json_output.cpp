@@ -27,16 +27,6 @@ nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts) {
   return out;
 }
 
-namespace {
-
-nlohmann::json UnconstrainedToJson(const std::vector<FreeSlide>& slides) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const FreeSlide& slide : slides) out.push_back(settings::FreeSlideToJson(slide));
-  return out;
-}
-
-}  // namespace
-
 nlohmann::json RegistrationToJson(const RegistrationResult& r,
                                   const std::vector<std::string>& auto_fields) {
   return {{"transform", TransformToJson(r.transform)},
@@ -48,7 +38,7 @@ nlohmann::json RegistrationToJson(const RegistrationResult& r,
           {"confidence", r.confidence},
           {"seen_through", r.features.seen_through},
           {"constrained_share", r.features.constrained_share},
-          {"unconstrained", UnconstrainedToJson(r.unconstrained)},
+          {"unconstrained", settings::FreeSlidesToJson(r.unconstrained)},
           {"doubtful", r.doubtful},
           {"attempts", AttemptsToJson(r.attempts)},
           {"answered_by", RungName(r.answered_by)},

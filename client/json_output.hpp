@@ -16,8 +16,7 @@ nlohmann::json AttemptsToJson(const std::vector<Attempt>& attempts);
 
 /// {"transform", "objective", "fitness", "inlier_rmse", "overlap",
 ///  "search_reach", "confidence", "doubtful", "seen_through",
-///  "constrained_share", "unconstrained" (settings::FreeSlideToJson
-///  of each), "attempts", "answered_by"
+///  "constrained_share", "unconstrained" (settings::FreeSlidesToJson), "attempts", "answered_by"
 ///  (RungName), "evaluations" (of every rung), "runtime_s",
 ///  "config" (the settings used: settings::ConfigToJson), "auto"
 ///  (`auto_fields`: the settings chosen from the clouds), plus GP and

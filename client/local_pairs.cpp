@@ -71,7 +71,7 @@ void UpgradeOldPairConfig(json& config, const std::string& source) {
 // keys added since: they read as trusted (no doubtful flag, PairResult's
 // confidence), unknown (overlap, search_reach), the full search
 // (answered_by, as every pair was before the ladder) and the settings under
-// today's names. Files of format 1 predate the unconstrained directions:
+// today's names. Files of format 1 predate the unconstrained slides:
 // not measured (null). Files of a later format are refused, not misread.
 void MigratePairFile(json& j, const std::string& path) {
   const int format = j.value("format", 0);

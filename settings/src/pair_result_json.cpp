@@ -28,10 +28,7 @@ json ValueToJson(const T& value) {
   } else if constexpr (std::is_same_v<T, Rung>) {
     return RungName(value);
   } else if constexpr (std::is_same_v<T, std::optional<std::vector<FreeSlide>>>) {
-    if (!value) return json(nullptr);
-    json slides = json::array();
-    for (const FreeSlide& slide : *value) slides.push_back(FreeSlideToJson(slide));
-    return slides;
+    return value ? FreeSlidesToJson(*value) : json(nullptr);
   } else {
     return value;
   }
@@ -72,10 +69,14 @@ T ValueFromJson(const json& value) {
 
 }  // namespace
 
-json FreeSlideToJson(const FreeSlide& slide) {
-  return {{"axis", {slide.axis.x(), slide.axis.y(), slide.axis.z()}},
-          {"extent_m", slide.extent},
-          {"across_share", slide.across_share}};
+json FreeSlidesToJson(const std::vector<FreeSlide>& slides) {
+  json out = json::array();
+  for (const FreeSlide& slide : slides) {
+    out.push_back({{"axis", {slide.axis.x(), slide.axis.y(), slide.axis.z()}},
+                   {"extent_m", slide.extent},
+                   {"across_share", slide.across_share}});
+  }
+  return out;
 }
 
 FreeSlide FreeSlideFromJson(const json& in) {

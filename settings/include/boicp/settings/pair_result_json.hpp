@@ -13,10 +13,10 @@ namespace boicp::settings {
 /// rows, answered_by as RungName's word, an unknown value as null.
 nlohmann::json PairResultToJson(const PairResult& result, PairResultFormat format);
 
-/// {"axis": [x, y, z], "extent_m", "across_share"}.
-nlohmann::json FreeSlideToJson(const FreeSlide& slide);
+/// One object per slide: {"axis": [x, y, z], "extent_m", "across_share"}.
+nlohmann::json FreeSlidesToJson(const std::vector<FreeSlide>& slides);
 
-/// The reverse of FreeSlideToJson. Throws InputError when malformed.
+/// One object of FreeSlidesToJson's, back. Throws InputError when malformed.
 FreeSlide FreeSlideFromJson(const nlohmann::json& json);
 
 /// The reverse of PairResultToJson. Throws InputError naming the first key
