@@ -154,9 +154,9 @@ std::vector<Transform> FeatureGuesses(const ScanPyramid& source_scan,
   return guesses;
 }
 
-// What an answer of scans that do not overlap looks like (NoOverlapFound).
+// The fitness under which an answer that the target's view refutes
+// (kSeenThroughOfNoTrust) says the scans do not overlap (NoOverlapFound).
 constexpr double kNoOverlapFitness = 0.1;
-constexpr double kNoOverlapSeenThrough = 0.3;
 
 // One answer assessed twice: a rival basin that one rung found stays found,
 // though a later rung's search may not visit it, so the later assessment
@@ -312,7 +312,7 @@ class Ladder {
   // the full search and the retry would find nothing to trust either.
   bool NoOverlapFound() const {
     return std::all_of(attempts_.begin(), attempts_.end(), [](const Attempt& a) {
-      return a.fitness < kNoOverlapFitness && a.features.seen_through >= kNoOverlapSeenThrough;
+      return a.fitness < kNoOverlapFitness && a.features.seen_through >= kSeenThroughOfNoTrust;
     });
   }
 

@@ -39,7 +39,6 @@ constexpr double kFitnessOfFullTrust = 0.1;
 // the scans plus sampling at depth edges, a few per cent; a street turned
 // half round puts a third of its points there (bench/README.md).
 constexpr double kSeenThroughOfFullTrust = 0.15;
-constexpr double kSeenThroughOfNoTrust = 0.3;
 // An answer free to slide along some direction (a corridor, a floor, a
 // wall) is right only by chance along it: trust falls from full just above
 // kUnconstrainedShare (a slide of 10 inlier distances moves the matches off
@@ -49,6 +48,12 @@ constexpr double kSeenThroughOfNoTrust = 0.3;
 constexpr double kConstrainedShareOfFullTrust = 1.06 * kUnconstrainedShare;
 constexpr double kConstrainedShareOfNoTrust = 0.5 * kUnconstrainedShare;
 
+// A cap that rises linearly from 0 where `value` is `no_trust` to 1 where it
+// is `full_trust` (either way round), and stays there beyond.
+double TrustBetween(double value, double no_trust, double full_trust) {
+  return std::clamp((value - no_trust) / (full_trust - no_trust), 0.0, 1.0);
+}
+
 }  // namespace
 
 double Confidence(const ConfidenceFeatures& f) {
@@ -57,16 +62,11 @@ double Confidence(const ConfidenceFeatures& f) {
                    kResolutionDeg * f.resolution_deg;
   const double model = 1.0 / (1.0 + std::exp(-z));
   const double tie_cap =
-      f.margin_measured
-          ? std::clamp((f.margin - kMarginFloor) / (kMarginOfFullTrust - kMarginFloor), 0.0, 1.0)
-          : 1.0;
-  const double seen_through_cap = std::clamp(
-      (kSeenThroughOfNoTrust - f.seen_through) / (kSeenThroughOfNoTrust - kSeenThroughOfFullTrust),
-      0.0, 1.0);
+      f.margin_measured ? TrustBetween(f.margin, kMarginFloor, kMarginOfFullTrust) : 1.0;
+  const double seen_through_cap =
+      TrustBetween(f.seen_through, kSeenThroughOfNoTrust, kSeenThroughOfFullTrust);
   const double free_slide_cap =
-      std::clamp((f.constrained_share - kConstrainedShareOfNoTrust) /
-                     (kConstrainedShareOfFullTrust - kConstrainedShareOfNoTrust),
-                 0.0, 1.0);
+      TrustBetween(f.constrained_share, kConstrainedShareOfNoTrust, kConstrainedShareOfFullTrust);
   return std::min({model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, tie_cap, seen_through_cap,
                    free_slide_cap});
 }

@@ -28,6 +28,10 @@ struct ConfidenceFeatures {
   double constrained_share = 1.0;
 };
 
+/// The seen_through share from which an answer has no trust at all: it puts
+/// that much of the source where the target's sensor saw through.
+constexpr double kSeenThroughOfNoTrust = 0.3;
+
 /// Estimated probability, in [0, 1), that the answer is within the success
 /// thresholds (2 degrees, and a few refinement voxels of translation); 0
 /// with no inliers, under 0.5 with fitness under 0.05, a measured margin
