@@ -613,6 +613,45 @@ TEST_F(MapCli, SevenScenesDriveClosesItsOwnLoops) {
   EXPECT_LT(with, 0.8 * without);
 }
 
+// A real VLP-16 drive that comes back to its start after a gap no
+// registration bridges (scans 9-21, then 385-386 of ../shared/data/vlp16_loop):
+// the chain puts the return tens of metres off; place recognition finds the
+// return whatever the chain says, registration trusts it, and the map's
+// revisits agree with revisits.csv.
+TEST_F(MapCli, AVlp16ReturnIsFoundByItsPlace) {
+  const fs::path data = fs::path(BOICP_SHARED_DATA_DIR) / "vlp16_loop";
+  if (!fs::is_directory(data)) GTEST_SKIP() << "shared data not found at " << data;
+  const fs::path drive = dir_ / "vlp16_return";
+  fs::create_directories(drive);
+  std::vector<int> frames = {385, 386};
+  for (int frame = 9; frame <= 21; ++frame) frames.push_back(frame);
+  for (const int frame : frames) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.pcd", frame);
+    fs::create_symlink(data / "pcd" / name, drive / name);
+  }
+  const auto revisits = [&](const fs::path& out) {
+    const RunResult r =
+        Run("eval " + out.string() + " --reference " + (data / "revisits.csv").string());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return r.out;
+  };
+  const fs::path chain = dir_ / "chain", looped = dir_ / "looped";
+  ASSERT_EQ(Run("map " + drive.string() + " -o " + chain.string() + " --loops off").exit_code, 0);
+  EXPECT_THAT(revisits(chain), HasSubstr("revisits: 0 of 2 within"));
+
+  const RunResult r = Run("map " + drive.string() + " -o " + looped.string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(revisits(looped), HasSubstr("revisits: 2 of 2 within 0.3 m and 2 deg"));
+  int closed_by_place = 0;
+  for (const json& pair : json::parse(Slurp(looped / "pairs.json"))) {
+    if (pair["kind"] == "loop" && pair["found_by"] == "place" && pair["in_graph"].get<bool>()) {
+      ++closed_by_place;
+    }
+  }
+  EXPECT_GE(closed_by_place, 1);
+}
+
 // A drive whose scan 3 is noise: neither of its pairs can be trusted. The
 // bridge 2 -> 4 holds the chain together; scan 3 is named, kept in the
 // trajectory, and fused only with --untrusted-scans place.

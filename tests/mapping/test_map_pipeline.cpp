@@ -166,5 +166,15 @@ TEST(MapPipeline, GraphEdgesAreTheChainThenExtrasNotPairingTheSameScans) {
   EXPECT_THAT(PairsInGraph(edges, estimate), ElementsAre(PairIndex{1, 0}, PairIndex{2, 1}));
 }
 
+// The closing line counts loops as the issue names them, in good English.
+TEST(MapPipeline, TheLoopLineCountsClosedLoopsAndCandidates) {
+  EXPECT_EQ(LoopStageSummary{}.Line(), "");
+  EXPECT_EQ((LoopStageSummary{1, 1, 1.0, 50.0}.Line()),
+            "1 loop closed of 1 candidate; verifying them took 1 s, 2 % of the other pairs' 50 s");
+  EXPECT_THAT((LoopStageSummary{40, 12, 30.0, 120.0}.Line()),
+              ::testing::StartsWith("12 loops closed of 40 candidates; verifying them took 30 s, "
+                                    "25 %"));
+}
+
 }  // namespace
 }  // namespace boicp

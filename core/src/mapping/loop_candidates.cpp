@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <map>
 #include <stdexcept>
+#include <utility>
 
 namespace boicp {
 namespace {
@@ -51,11 +52,55 @@ std::vector<LoopCandidate> PairsWithinReach(const std::vector<Transform>& poses,
   return within;
 }
 
-bool NearKept(const LoopCandidate& c, const std::vector<LoopCandidate>& kept, int spacing) {
-  return std::any_of(kept.begin(), kept.end(), [&](const LoopCandidate& k) {
-    return std::abs(k.pair.source - c.pair.source) < spacing &&
-           std::abs(k.pair.target - c.pair.target) < spacing;
+bool NearAny(const PairIndex& pair, const std::vector<PairIndex>& others, int spacing) {
+  return std::any_of(others.begin(), others.end(), [&](const PairIndex& k) {
+    return std::abs(k.source - pair.source) < spacing && std::abs(k.target - pair.target) < spacing;
   });
+}
+
+// `budget_per_scan` times the drive's scans, at least one.
+size_t DriveBudget(double budget_per_scan, size_t num_scans) {
+  return static_cast<size_t>(
+      std::max(1.0, std::floor(budget_per_scan * static_cast<double>(num_scans))));
+}
+
+// The candidates `ranked` (best first) taken greedily under the per-scan
+// cap, the spacing from those taken and from `near`, and `budget`; sorted
+// by pair.
+std::vector<LoopCandidate> TakeBest(const std::vector<LoopCandidate>& ranked, size_t budget,
+                                    std::vector<PairIndex> near,
+                                    const LoopCandidateOptions& options) {
+  std::vector<LoopCandidate> kept;
+  std::map<int, int> per_scan;
+  for (const LoopCandidate& c : ranked) {
+    if (kept.size() >= budget) break;
+    if (per_scan[c.pair.source] >= options.max_per_scan) continue;
+    if (NearAny(c.pair, near, options.min_spacing)) continue;
+    ++per_scan[c.pair.source];
+    kept.push_back(c);
+    near.push_back(c.pair);
+  }
+  std::sort(kept.begin(), kept.end(),
+            [](const LoopCandidate& a, const LoopCandidate& b) { return a.pair < b.pair; });
+  return kept;
+}
+
+// The earlier scans (at least min_sequence_gap before `later`, described)
+// whose ring keys are nearest `later`'s, at most `count` of them.
+std::vector<int> RingKeyShortlist(const std::vector<PlaceDescriptor>& places, int later,
+                                  const LoopCandidateOptions& options) {
+  std::vector<std::pair<float, int>> by_key;
+  const auto& key = places[static_cast<size_t>(later)].ring_key;
+  for (int earlier = 0; earlier + options.min_sequence_gap <= later; ++earlier) {
+    const PlaceDescriptor& other = places[static_cast<size_t>(earlier)];
+    if (!other.empty()) by_key.emplace_back((other.ring_key - key).squaredNorm(), earlier);
+  }
+  const auto count = std::min(by_key.size(), static_cast<size_t>(options.place_shortlist));
+  std::partial_sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(count),
+                    by_key.end());
+  std::vector<int> shortlist;
+  for (size_t k = 0; k < count; ++k) shortlist.push_back(by_key[k].second);
+  return shortlist;
 }
 
 }  // namespace
@@ -70,26 +115,50 @@ LoopSearch LoopSearchFromName(const std::string& name, const std::string& field)
   throw InputError(field + ": '" + name + "' is not auto or off");
 }
 
+std::string LoopFoundByName(LoopFoundBy found_by) {
+  return found_by == LoopFoundBy::kPlace ? "place" : "poses";
+}
+
 std::vector<LoopCandidate> LoopCandidatesFromPoses(const std::vector<Transform>& poses,
                                                    const std::vector<Point>& view_centres,
                                                    const LoopCandidateOptions& options) {
   if (view_centres.size() != poses.size()) {
     throw std::invalid_argument("loop candidates: one view centre per pose");
   }
-  std::vector<LoopCandidate> kept;
-  std::map<int, int> per_scan;
-  const auto budget = static_cast<size_t>(
-      std::max(1.0, std::floor(options.max_per_drive_scan * static_cast<double>(poses.size()))));
-  for (const LoopCandidate& c : PairsWithinReach(poses, view_centres, options)) {
-    if (kept.size() >= budget) break;
-    if (per_scan[c.pair.source] >= options.max_per_scan) continue;
-    if (NearKept(c, kept, options.min_spacing)) continue;
-    ++per_scan[c.pair.source];
-    kept.push_back(c);
+  return TakeBest(PairsWithinReach(poses, view_centres, options),
+                  DriveBudget(options.max_per_drive_scan, poses.size()), {}, options);
+}
+
+std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescriptor>& places,
+                                                    const std::vector<Point>& sensor_origins,
+                                                    const std::vector<PairIndex>& taken,
+                                                    const LoopCandidateOptions& options) {
+  if (sensor_origins.size() != places.size()) {
+    throw std::invalid_argument("loop candidates: one sensor origin per place descriptor");
   }
-  std::sort(kept.begin(), kept.end(),
-            [](const LoopCandidate& a, const LoopCandidate& b) { return a.pair < b.pair; });
-  return kept;
+  std::vector<LoopCandidate> best_per_scan;
+  const int n = static_cast<int>(places.size());
+  for (int later = options.min_sequence_gap; later < n; ++later) {
+    const PlaceDescriptor& place = places[static_cast<size_t>(later)];
+    if (place.empty()) continue;
+    LoopCandidate best;
+    for (const int earlier : RingKeyShortlist(places, later, options)) {
+      const auto i = static_cast<size_t>(earlier), j = static_cast<size_t>(later);
+      const PlaceMatch match = MatchPlaces(place, places[i]);
+      if (match.distance >= best.place_distance) continue;
+      best.pair = {later, earlier};
+      best.prior = PlacePrior(match, sensor_origins[j], sensor_origins[i]);
+      best.found_by = LoopFoundBy::kPlace;
+      best.place_distance = match.distance;
+    }
+    if (best.found_by == LoopFoundBy::kPlace) best_per_scan.push_back(best);
+  }
+  std::stable_sort(best_per_scan.begin(), best_per_scan.end(),
+                   [](const LoopCandidate& a, const LoopCandidate& b) {
+                     return a.place_distance < b.place_distance;
+                   });
+  return TakeBest(best_per_scan, DriveBudget(options.max_place_per_drive_scan, places.size()),
+                  taken, options);
 }
 
 }  // namespace boicp

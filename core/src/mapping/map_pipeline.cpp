@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/loop_candidates.hpp"
 
 namespace boicp {
 namespace {
@@ -25,23 +26,21 @@ std::pair<int, int> Unordered(const PairIndex& p) {
   return {std::min(p.source, p.target), std::max(p.source, p.target)};
 }
 
-// Where each scan looks, in the map frame: its points' centroid moved by
-// its pose (its sensor origin when it has no points).
-std::vector<Point> ViewCentres(const std::vector<ScanSource>& scans,
-                               const std::vector<Transform>& poses) {
-  std::vector<Point> centres;
-  centres.reserve(scans.size());
-  for (size_t i = 0; i < scans.size(); ++i) {
-    const Points points = LoadPointCloud(scans[i].path, scans[i].load).points;
-    Point centroid = scans[i].sensor_origin;
-    if (!points.empty()) {
-      centroid = Point::Zero();
-      for (const Point& p : points) centroid += p;
-      centroid /= static_cast<double>(points.size());
-    }
-    centres.push_back(poses[i].topLeftCorner<3, 3>() * centroid + poses[i].topRightCorner<3, 1>());
+// The grid every scan of the batch is described on: its radius the median
+// PlaceRadius of up to five scans spread over the batch.
+PlaceGrid BatchPlaceGrid(const std::vector<ScanSource>& scans) {
+  constexpr size_t kSampled = 5;
+  const size_t count = std::min(kSampled, scans.size());
+  std::vector<double> radii;
+  for (size_t k = 0; k < count; ++k) {
+    const ScanSource& scan = scans[count == 1 ? 0 : k * (scans.size() - 1) / (count - 1)];
+    radii.push_back(PlaceRadius(LoadPointCloud(scan.path, scan.load).points, scan.sensor_origin));
   }
-  return centres;
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(count / 2),
+                   radii.end());
+  PlaceGrid grid;
+  grid.max_radius = radii[count / 2];
+  return grid;
 }
 
 // A later stage's progress: only the pairs it registers are new, and they
@@ -95,6 +94,27 @@ std::map<PairIndex, std::string> LeftOut(const GraphEdges& edges, const Register
 
 }  // namespace
 
+ScanViews ViewScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses) {
+  const PlaceGrid grid = BatchPlaceGrid(scans);
+  ScanViews views;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const Points points = LoadPointCloud(scans[i].path, scans[i].load).points;
+    Point centroid = scans[i].sensor_origin;
+    if (!points.empty()) {
+      centroid = Point::Zero();
+      for (const Point& p : points) centroid += p;
+      centroid /= static_cast<double>(points.size());
+    }
+    views.centres.push_back(poses[i].topLeftCorner<3, 3>() * centroid +
+                            poses[i].topRightCorner<3, 1>());
+    views.places.push_back(grid.max_radius > 0.0
+                               ? DescribePlace(points, scans[i].sensor_origin, grid)
+                               : PlaceDescriptor{});
+    views.sensor_origins.push_back(scans[i].sensor_origin);
+  }
+  return views;
+}
+
 GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& registered) {
   GraphEdges edges;
   std::set<std::pair<int, int>> in_chain;
@@ -144,8 +164,8 @@ void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairSto
         continue;
       }
       plan.extras.push_back(bridge);
-      plan.chained_priors[bridge] = chained.poses[static_cast<size_t>(bridge.target)].inverse() *
-                                    chained.poses[static_cast<size_t>(bridge.source)];
+      plan.found_priors[bridge] = chained.poses[static_cast<size_t>(bridge.target)].inverse() *
+                                  chained.poses[static_cast<size_t>(bridge.source)];
       plan.bridges.insert(bridge);
       bridges.push_back(bridge);
     }
@@ -195,12 +215,27 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
 
   PairingPlan plan = PlanFixedPairs(registered.chain, batch.plan.extras);
   std::vector<PairIndex> loops;
-  for (const LoopCandidate& c :
-       LoopCandidatesFromPoses(chained.poses, ViewCentres(batch.scans, chained.poses), options)) {
-    if (registered_already.count(Unordered(c.pair)) != 0) continue;
+  const auto propose = [&](const LoopCandidate& c) {
+    if (registered_already.count(Unordered(c.pair)) != 0) return;
     plan.extras.push_back(c.pair);
-    plan.chained_priors[c.pair] = c.prior;
+    plan.found_priors[c.pair] = c.prior;
+    if (c.found_by == LoopFoundBy::kPlace) plan.places.insert(c.pair);
     loops.push_back(c.pair);
+  };
+  const ScanViews views = ViewScans(batch.scans, chained.poses);
+  for (const LoopCandidate& c : LoopCandidatesFromPoses(chained.poses, views.centres, options)) {
+    propose(c);
+  }
+  // Pairs already registered or proposed are not proposed again, nor their
+  // neighbours: one closure per revisit stretch.
+  std::vector<PairIndex> taken = loops;
+  for (const auto& entry : registered.finished) {
+    const auto [earlier, later] = Unordered(entry.first);
+    taken.push_back({later, earlier});
+  }
+  for (const LoopCandidate& c :
+       LoopCandidatesFromPlaces(views.places, views.sensor_origins, taken, options)) {
+    propose(c);
   }
   if (loops.empty()) return;
   StageProgress loop_progress(progress, static_cast<int>(registered.finished.size()));
@@ -239,9 +274,10 @@ std::string LoopStageSummary::Line() const {
   if (candidates == 0) return "";
   char line[200];
   std::snprintf(line, sizeof(line),
-                "%d loops closed of %d candidates; verifying them took %.0f s, %.0f %% of the "
-                "other pairs' %.0f s",
-                closed, candidates, seconds,
+                "%d %s closed of %d %s; verifying them took %.0f s, %.0f %% of the other "
+                "pairs' %.0f s",
+                closed, closed == 1 ? "loop" : "loops", candidates,
+                candidates == 1 ? "candidate" : "candidates", seconds,
                 other_seconds > 0.0 ? 100.0 * seconds / other_seconds : 0.0, other_seconds);
   return line;
 }

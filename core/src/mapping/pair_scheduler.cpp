@@ -13,6 +13,7 @@
 #include <string>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/loop_candidates.hpp"
 #include "boicp/mapping/pair_scale.hpp"
 #include "boicp/mapping/prepared_scan_cache.hpp"
 #include "boicp/util/types.hpp"
@@ -58,9 +59,11 @@ void MarkKind(const PairingPlan& plan, PairResult& result) {
   const bool extra =
       std::find(plan.extras.begin(), plan.extras.end(), result.pair) != plan.extras.end();
   const bool bridge = plan.bridges.count(result.pair) != 0;
-  const bool loop = !bridge && plan.chained_priors.count(result.pair) != 0;
+  const bool loop = !bridge && plan.found_priors.count(result.pair) != 0;
   result.kind = bridge ? "bridge" : loop ? "loop" : extra ? "extra" : "chain";
-  result.found_by = loop ? "poses" : "";
+  const LoopFoundBy found_by =
+      plan.places.count(result.pair) != 0 ? LoopFoundBy::kPlace : LoopFoundBy::kPoses;
+  result.found_by = loop ? LoopFoundByName(found_by) : "";
 }
 
 // The batch's settings at each scale step its pairs use, with each scan
@@ -300,11 +303,11 @@ class PairScheduler {
     } else {
       try {
         ScaledPreparation::Level& level = preparation_.For(pair);
-        const auto prior = plan_.chained_priors.find(pair);
+        const auto prior = plan_.found_priors.find(pair);
         BoIcpConfig config = level.config;
-        config.full_search_when_doubtful = prior == plan_.chained_priors.end();
+        config.full_search_when_doubtful = prior == plan_.found_priors.end();
         PairResult result = RegisterBatchPair(scans_, pair, config, *level.prepared, stop,
-                                              prior != plan_.chained_priors.end()
+                                              prior != plan_.found_priors.end()
                                                   ? std::optional<Transform>(prior->second)
                                                   : std::nullopt);
         MarkKind(plan_, result);

@@ -1,19 +1,22 @@
 #pragma once
-// Loop-closure candidates found on a chained trajectory: scans far apart
-// along the drive whose views lie within reach of each other under the
-// chain, the reach growing with the distance driven between them, since
-// that is how far the chain may have drifted.
+// Loop-closure candidates: scans far apart along the drive that may see one
+// place. Found two ways: on the chained trajectory (views within reach of
+// each other, the reach growing with the distance driven between them,
+// since that is how far the chain may have drifted), and by place
+// recognition, which holds however far the chain drifted or broke.
 
+#include <string>
 #include <vector>
 
 #include "boicp/mapping/map_pairs.hpp"
+#include "boicp/mapping/place_recognition.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
 
 /// Whether a map looks for loops on its own.
 enum class LoopSearch {
-  kAuto,  ///< candidates from the chained poses, verified by registration
+  kAuto,  ///< candidates from the chained poses and by place, verified by registration
   kOff,   ///< only the pairs the plan lists
 };
 
@@ -42,15 +45,34 @@ struct LoopCandidateOptions {
   /// At most this many candidates per scan of the drive in all, the best
   /// first, so that verifying them costs a bounded share of the chain.
   double max_per_drive_scan = 0.25;
+  /// The same budget for candidates found by place recognition, on top: a
+  /// drive's best-looking pairs are proposed whether or not it comes back,
+  /// so this budget is what a drive without revisits spends.
+  double max_place_per_drive_scan = 0.05;
+  /// Place recognition compares each scan in full with this many earlier
+  /// scans, those whose ring keys (PlaceDescriptor) are nearest.
+  int place_shortlist = 10;
 };
+
+/// How a loop candidate was found (PairResult::found_by names it).
+enum class LoopFoundBy {
+  kPoses,  ///< "poses": the views lie within reach under the chained poses
+  kPlace,  ///< "place": the scans' place descriptors match
+};
+
+/// "poses" or "place".
+std::string LoopFoundByName(LoopFoundBy found_by);
 
 struct LoopCandidate {
   PairIndex pair;  ///< source: the later scan; target: the earlier one
-  /// The chained poses' T_target_source: the prior its registration is centred on.
+  /// T_target_source its registration is centred on: the chained poses', or
+  /// the place match's heading (PlacePrior).
   Transform prior = Transform::Identity();
-  double distance = 0.0;  ///< metres between the two views under the chain
-  double reach = 0.0;     ///< metres they were allowed to lie apart
-  double path = 0.0;      ///< metres driven from one to the other along the chain
+  LoopFoundBy found_by = LoopFoundBy::kPoses;
+  double distance = 0.0;        ///< poses: metres between the two views under the chain
+  double reach = 0.0;           ///< poses: metres they were allowed to lie apart
+  double path = 0.0;            ///< poses: metres driven from one to the other along the chain
+  double place_distance = 1.0;  ///< place: PlaceMatch::distance
 };
 
 /// Candidates among scans with chained poses `poses` (T_map_scan), each scan
@@ -65,5 +87,19 @@ struct LoopCandidate {
 std::vector<LoopCandidate> LoopCandidatesFromPoses(const std::vector<Transform>& poses,
                                                    const std::vector<Point>& view_centres,
                                                    const LoopCandidateOptions& options);
+
+/// Candidates among scans described by `places` (one per scan, empty for a
+/// scan that does not see all around), each sensor at `sensor_origins` in
+/// its scan's frame. Each later scan is matched (MatchPlaces) with the
+/// earlier scans whose ring keys are nearest and keeps its best; these are
+/// taken most alike first under the per-scan cap, the spacing (also from
+/// every pair of `taken`, e.g. the candidates from poses) and the drive's
+/// place budget (at least one). No pair closer than min_sequence_gap along
+/// the sequence. Sorted by (source, target). Preconditions: one origin per
+/// descriptor; non-empty descriptors of one grid; options as above.
+std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescriptor>& places,
+                                                    const std::vector<Point>& sensor_origins,
+                                                    const std::vector<PairIndex>& taken,
+                                                    const LoopCandidateOptions& options);
 
 }  // namespace boicp

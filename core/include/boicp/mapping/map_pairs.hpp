@@ -50,12 +50,16 @@ struct PairingPlan {
   double overlap_threshold = 0.7;  // keyframes only, in (0, 1]
   std::vector<PairIndex> chain;    // fixed plans: chained first into poses
   std::vector<PairIndex> extras;   // loop closures on top of the chain
-  /// Extras found on the chained poses (bridges and loop candidates), each
-  /// with the chain's T_target_source: their searches are centred there.
-  std::map<PairIndex, Transform> chained_priors;
+  /// Extras the map found (bridges and loop candidates), each with the
+  /// T_target_source its search is centred on: the chained poses', or a
+  /// place match's heading.
+  std::map<PairIndex, Transform> found_priors;
   /// Of those, the bridges over doubtful chain pairs; the others are loop
   /// candidates.
   std::set<PairIndex> bridges;
+  /// Of the loop candidates, those found by place recognition; the others
+  /// were found on the chained poses.
+  std::set<PairIndex> places;
 };
 
 /// A fixed plan: `chain` (consecutive or explicit pairs) plus `extras`.

@@ -13,6 +13,7 @@
 #include "boicp/mapping/map_assembly.hpp"
 #include "boicp/mapping/map_batch.hpp"
 #include "boicp/mapping/pair_scheduler.hpp"
+#include "boicp/mapping/place_recognition.hpp"
 
 namespace boicp {
 
@@ -47,12 +48,28 @@ bool IsBridged(const PairIndex& link, const RegisteredPairs& registered);
 /// bridges tried"; empty when no bridge was tried.
 std::string BridgeSummaryLine(const RegisteredPairs& registered);
 
-/// The loop stage of a batch whose plan is registered: candidates found on
-/// the poses of `registered` (LoopCandidatesFromPoses, each scan seen from
-/// its points' centroid, the reach being the batch's translation box) and
-/// not registered yet are registered on `execution` with the chain's
-/// relative pose as their prior, stored in `store` and added to
-/// registered.finished and registered.loops. Their progress goes to
+/// What the loop search knows of each scan of a batch, each loaded once:
+/// where it looks in the map frame (its points' centroid moved by its pose;
+/// its sensor origin when it has no points), its place descriptor on the
+/// batch's grid (radius: the median PlaceRadius of up to five scans spread
+/// over the batch) and its sensor origin.
+struct ScanViews {
+  std::vector<Point> centres;
+  std::vector<PlaceDescriptor> places;
+  std::vector<Point> sensor_origins;
+};
+
+/// Precondition: one pose (T_map_scan) per scan. Throws InputError when a
+/// scan does not load.
+ScanViews ViewScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses);
+
+/// The loop stage of a batch whose plan is registered. Candidates found on
+/// the poses of `registered` (LoopCandidatesFromPoses, the reach being the
+/// batch's translation box; prior: the chain's relative pose), then by
+/// place recognition (LoopCandidatesFromPlaces, clear of every pair
+/// registered or proposed; prior: the match's heading), and not registered
+/// yet are registered on `execution` up to the short search, stored in
+/// `store` and added to registered.finished and registered.loops. Their progress goes to
 /// `progress`; the pairs registered before are not reported again. Throws
 /// what RegisterPlannedPairs throws, and InputError when a scan no longer loads.
 void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
