@@ -117,6 +117,12 @@ class PlaceCandidatesOnALoop : public ::testing::Test {
   }
   static void TearDownTestSuite() { delete places_; }
   static std::vector<Point> Origins() { return std::vector<Point>(kScans, Point::Zero()); }
+  // Every scan a piece of its own: nothing trusted connects any two.
+  static std::vector<int> Apart() {
+    std::vector<int> pieces(kScans);
+    for (int i = 0; i < kScans; ++i) pieces[static_cast<size_t>(i)] = i;
+    return pieces;
+  }
   static constexpr int kScans = 30;
   static std::vector<PlaceDescriptor>* places_;
 };
@@ -126,7 +132,7 @@ TEST_F(PlaceCandidatesOnALoop, FindsReturnsAtTheirHeading) {
   LoopCandidateOptions options;
   options.max_place_per_drive_scan = 0.1;
   const std::vector<LoopCandidate> found =
-      LoopCandidatesFromPlaces(*places_, Origins(), {}, options);
+      LoopCandidatesFromPlaces(*places_, Origins(), Apart(), {}, options);
   ASSERT_GE(found.size(), 2u) << "10 returns, candidates 5 apart";
   EXPECT_LE(found.size(), 3u) << "the budget: a tenth of 30 scans";
   // A street seen from 30 m further on, turned around, can look alike too:
@@ -151,20 +157,42 @@ TEST_F(PlaceCandidatesOnALoop, FindsReturnsAtTheirHeading) {
 TEST_F(PlaceCandidatesOnALoop, StaysClearOfPairsAlreadyTaken) {
   LoopCandidateOptions options;
   options.max_place_per_drive_scan = 1.0;
-  const std::vector<LoopCandidate> all = LoopCandidatesFromPlaces(*places_, Origins(), {}, options);
+  const std::vector<LoopCandidate> all =
+      LoopCandidatesFromPlaces(*places_, Origins(), Apart(), {}, options);
   ASSERT_FALSE(all.empty());
   const PairIndex taken = all.front().pair;
-  for (const LoopCandidate& c : LoopCandidatesFromPlaces(*places_, Origins(), {taken}, options)) {
+  for (const LoopCandidate& c :
+       LoopCandidatesFromPlaces(*places_, Origins(), Apart(), {taken}, options)) {
     EXPECT_FALSE(std::abs(c.pair.source - taken.source) < options.min_spacing &&
                  std::abs(c.pair.target - taken.target) < options.min_spacing)
         << PairName(c.pair);
   }
 }
 
+// Scans that trusted pairs already connect are placed by the chain: place
+// recognition only joins pieces.
+TEST_F(PlaceCandidatesOnALoop, JoinsOnlyScansOfDifferentPieces) {
+  LoopCandidateOptions options;
+  options.max_place_per_drive_scan = 1.0;
+  const std::vector<int> one_piece(kScans, 0);
+  EXPECT_TRUE(LoopCandidatesFromPlaces(*places_, Origins(), one_piece, {}, options).empty());
+  std::vector<int> split(kScans, 0);
+  std::fill(split.begin() + 20, split.end(), 20);  // the way back is a piece of its own
+  const std::vector<LoopCandidate> found =
+      LoopCandidatesFromPlaces(*places_, Origins(), split, {}, options);
+  ASSERT_FALSE(found.empty());
+  for (const LoopCandidate& c : found) {
+    EXPECT_GE(c.pair.source, 20) << PairName(c.pair);
+    EXPECT_LT(c.pair.target, 20) << PairName(c.pair);
+  }
+}
+
 TEST(PlaceCandidates, NoDescriptorsNoCandidates) {
   const std::vector<PlaceDescriptor> none(30);
-  EXPECT_TRUE(
-      LoopCandidatesFromPlaces(none, std::vector<Point>(30, Point::Zero()), {}, {}).empty());
+  std::vector<int> pieces(30);
+  for (int i = 0; i < 30; ++i) pieces[static_cast<size_t>(i)] = i;
+  EXPECT_TRUE(LoopCandidatesFromPlaces(none, std::vector<Point>(30, Point::Zero()), pieces, {}, {})
+                  .empty());
   EXPECT_EQ(LoopFoundByName(LoopFoundBy::kPlace), "place");
   EXPECT_EQ(LoopFoundByName(LoopFoundBy::kPoses), "poses");
 }

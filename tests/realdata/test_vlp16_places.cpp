@@ -71,9 +71,13 @@ TEST(Vlp16Places, TheMapsLoopSearchProposesBothRevisitStretches) {
 
   const ScanViews views =
       ViewScans(scans, std::vector<Transform>(scans.size(), Transform::Identity()));
+  // Every scan a piece of its own, as if no pair were trusted: the search
+  // alone, over the whole drive.
+  std::vector<int> pieces(scans.size());
+  for (size_t i = 0; i < pieces.size(); ++i) pieces[i] = static_cast<int>(i);
   const LoopCandidateOptions options;
   const std::vector<LoopCandidate> found =
-      LoopCandidatesFromPlaces(views.places, views.sensor_origins, {}, options);
+      LoopCandidatesFromPlaces(views.places, views.sensor_origins, pieces, {}, options);
   EXPECT_EQ(found.size(), static_cast<size_t>(options.max_place_per_drive_scan * scans.size()));
 
   // The two stretches the drive passes again (PROVENANCE.txt): scans 376-387

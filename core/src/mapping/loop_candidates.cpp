@@ -85,15 +85,18 @@ std::vector<LoopCandidate> TakeBest(const std::vector<LoopCandidate>& ranked, si
   return kept;
 }
 
-// The earlier scans (at least min_sequence_gap before `later`, described)
-// whose ring keys are nearest `later`'s, at most `count` of them.
-std::vector<int> RingKeyShortlist(const std::vector<PlaceDescriptor>& places, int later,
+// The earlier scans (at least min_sequence_gap before `later`, described,
+// of another piece) whose ring keys are nearest `later`'s, at most
+// options.place_shortlist of them.
+std::vector<int> RingKeyShortlist(const std::vector<PlaceDescriptor>& places,
+                                  const std::vector<int>& pieces, int later,
                                   const LoopCandidateOptions& options) {
   std::vector<std::pair<float, int>> by_key;
-  const auto& key = places[static_cast<size_t>(later)].ring_key;
+  const auto j = static_cast<size_t>(later);
   for (int earlier = 0; earlier + options.min_sequence_gap <= later; ++earlier) {
-    const PlaceDescriptor& other = places[static_cast<size_t>(earlier)];
-    if (!other.empty()) by_key.emplace_back((other.ring_key - key).squaredNorm(), earlier);
+    const auto i = static_cast<size_t>(earlier);
+    if (places[i].empty() || pieces[i] == pieces[j]) continue;
+    by_key.emplace_back((places[i].ring_key - places[j].ring_key).squaredNorm(), earlier);
   }
   const auto count = std::min(by_key.size(), static_cast<size_t>(options.place_shortlist));
   std::partial_sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(count),
@@ -131,10 +134,11 @@ std::vector<LoopCandidate> LoopCandidatesFromPoses(const std::vector<Transform>&
 
 std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescriptor>& places,
                                                     const std::vector<Point>& sensor_origins,
+                                                    const std::vector<int>& pieces,
                                                     const std::vector<PairIndex>& taken,
                                                     const LoopCandidateOptions& options) {
-  if (sensor_origins.size() != places.size()) {
-    throw std::invalid_argument("loop candidates: one sensor origin per place descriptor");
+  if (sensor_origins.size() != places.size() || pieces.size() != places.size()) {
+    throw std::invalid_argument("loop candidates: one sensor origin and piece per descriptor");
   }
   std::vector<LoopCandidate> best_per_scan;
   const int n = static_cast<int>(places.size());
@@ -142,7 +146,7 @@ std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescr
     const PlaceDescriptor& place = places[static_cast<size_t>(later)];
     if (place.empty()) continue;
     LoopCandidate best;
-    for (const int earlier : RingKeyShortlist(places, later, options)) {
+    for (const int earlier : RingKeyShortlist(places, pieces, later, options)) {
       const auto i = static_cast<size_t>(earlier), j = static_cast<size_t>(later);
       const PlaceMatch match = MatchPlaces(place, places[i]);
       if (match.distance >= best.place_distance) continue;

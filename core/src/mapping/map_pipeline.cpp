@@ -71,6 +71,24 @@ class StageProgress : public MapProgressSink {
 
 bool IsTrusted(const PairResult& result) { return result.confidence >= kTrustedFrom; }
 
+// Each scan's piece: scans that trusted pairs connect, however indirectly,
+// share one label (the smallest index among them).
+std::vector<int> TrustedPieces(int num_scans, const RegisteredPairs& registered) {
+  std::vector<int> piece(static_cast<size_t>(num_scans));
+  for (int i = 0; i < num_scans; ++i) piece[static_cast<size_t>(i)] = i;
+  const auto root = [&piece](int i) {
+    while (piece[static_cast<size_t>(i)] != i) i = piece[static_cast<size_t>(i)];
+    return i;
+  };
+  for (const auto& [pair, result] : registered.finished) {
+    if (!IsTrusted(result)) continue;
+    const int a = root(pair.source), b = root(pair.target);
+    piece[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  }
+  for (int i = 0; i < num_scans; ++i) piece[static_cast<size_t>(i)] = root(i);
+  return piece;
+}
+
 // Why each edge the poses do not use, and each bridge or loop candidate
 // that was no edge, was left out.
 std::map<PairIndex, std::string> LeftOut(const GraphEdges& edges, const RegisteredPairs& registered,
@@ -226,15 +244,17 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
   for (const LoopCandidate& c : LoopCandidatesFromPoses(chained.poses, views.centres, options)) {
     propose(c);
   }
-  // Pairs already registered or proposed are not proposed again, nor their
+  // Place recognition joins only scans no trusted pair connects yet; pairs
+  // already registered or proposed are not proposed again, nor their
   // neighbours: one closure per revisit stretch.
   std::vector<PairIndex> taken = loops;
   for (const auto& entry : registered.finished) {
     const auto [earlier, later] = Unordered(entry.first);
     taken.push_back({later, earlier});
   }
+  const std::vector<int> pieces = TrustedPieces(static_cast<int>(batch.scans.size()), registered);
   for (const LoopCandidate& c :
-       LoopCandidatesFromPlaces(views.places, views.sensor_origins, taken, options)) {
+       LoopCandidatesFromPlaces(views.places, views.sensor_origins, pieces, taken, options)) {
     propose(c);
   }
   if (loops.empty()) return;

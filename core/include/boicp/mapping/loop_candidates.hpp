@@ -90,15 +90,20 @@ std::vector<LoopCandidate> LoopCandidatesFromPoses(const std::vector<Transform>&
 
 /// Candidates among scans described by `places` (one per scan, empty for a
 /// scan that does not see all around), each sensor at `sensor_origins` in
-/// its scan's frame. Each later scan is matched (MatchPlaces) with the
-/// earlier scans whose ring keys are nearest and keeps its best; these are
-/// taken most alike first under the per-scan cap, the spacing (also from
-/// every pair of `taken`, e.g. the candidates from poses) and the drive's
-/// place budget (at least one). No pair closer than min_sequence_gap along
-/// the sequence. Sorted by (source, target). Preconditions: one origin per
-/// descriptor; non-empty descriptors of one grid; options as above.
+/// its scan's frame, joining only scans of different `pieces` (one label
+/// per scan: the scans trusted pairs already connect share one). Within a
+/// piece the chained poses know where each scan is, and a place that looks
+/// alike but lies elsewhere is more likely a look-alike street than a loop.
+/// Each later scan is matched (MatchPlaces) with the earlier scans of other
+/// pieces whose ring keys are nearest and keeps its best; these are taken
+/// most alike first under the per-scan cap, the spacing (also from every
+/// pair of `taken`, e.g. the candidates from poses) and the drive's place
+/// budget (at least one). No pair closer than min_sequence_gap along the
+/// sequence. Sorted by (source, target). Preconditions: one origin and one
+/// piece per descriptor; non-empty descriptors of one grid; options as above.
 std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescriptor>& places,
                                                     const std::vector<Point>& sensor_origins,
+                                                    const std::vector<int>& pieces,
                                                     const std::vector<PairIndex>& taken,
                                                     const LoopCandidateOptions& options);
 
