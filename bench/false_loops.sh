@@ -6,7 +6,9 @@
 # Usage: bench/false_loops.sh OUT [--bin DIR] [--data-root DIR]
 #   50 pairs of another dataset: each KITTI 00 scan onto 5 VLP-16 scans;
 #   50 pairs of one drive with no overlap: VLP-16 scans 40-112 onto 300-348,
-#   stretches the drive never revisits (its revisits.csv).
+#   stretches the drive never revisits (its revisits.csv);
+#   50 look-alike pairs: a generated street drive (demo-data --scans 150),
+#   scans 60-132 onto scans 50-90 m before them, beyond the 35 m range.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,6 +30,9 @@ fi
 mkdir -p "$out"
 printf '1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n' >"$out/identity.txt"
 
+street="$out/generated_street"
+[ -f "$street/truth.kitti" ] || "$bin/boicp" demo-data --scans 150 -o "$street" >/dev/null
+
 pairs=()
 for kitti in "$data"/kitti00/velodyne/*.bin; do
   for scan in 000060 000120 000180 000320 000440; do pairs+=("another-dataset|$kitti|$vlp/$scan.pcd"); done
@@ -35,6 +40,11 @@ done
 for i in $(seq 40 8 112); do
   for j in $(seq 300 12 348); do
     pairs+=("no-overlap|$(printf '%s/%06d.pcd' "$vlp" "$i")|$(printf '%s/%06d.pcd' "$vlp" "$j")")
+  done
+done
+for i in $(seq 60 8 132); do
+  for back in 25 30 35 40 45; do
+    pairs+=("look-alike|$(printf '%s/scan_%03d.xyz' "$street" "$i")|$(printf '%s/scan_%03d.xyz' "$street" $((i - back)))")
   done
 done
 

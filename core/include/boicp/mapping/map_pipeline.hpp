@@ -66,12 +66,13 @@ ScanViews ViewScans(const std::vector<ScanSource>& scans, const std::vector<Tran
 /// The loop stage of a batch whose plan is registered. Candidates found on
 /// the poses of `registered` (LoopCandidatesFromPoses, the reach being the
 /// batch's translation box; prior: the chain's relative pose), then by
-/// place recognition (LoopCandidatesFromPlaces, clear of every pair
-/// registered or proposed; prior: the match's heading), and not registered
-/// yet are registered on `execution` up to the short search, stored in
-/// `store` and added to registered.finished and registered.loops. Their progress goes to
-/// `progress`; the pairs registered before are not reported again. Throws
-/// what RegisterPlannedPairs throws, and InputError when a scan no longer loads.
+/// place recognition between scans that no trusted pair of `registered`
+/// connects (LoopCandidatesFromPlaces, clear of every pair registered or
+/// proposed; prior: the match's heading), are registered on `execution` up
+/// to the short search, stored in `store` and added to registered.finished
+/// and registered.loops. Their progress goes to `progress`; the pairs
+/// registered before are not reported again. Throws what
+/// RegisterPlannedPairs throws, and InputError when a scan no longer loads.
 void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, PairStore& store,
                             MapProgressSink& progress, const PairExecution& execution);
 
