@@ -115,8 +115,16 @@ class MapCli : public ::testing::Test {
   std::vector<Transform> truth_;  // T_world_scan of MakeDrive's scans
 };
 
+// A pairs.json transform: 4 rows of 4.
+Transform TransformFromJson(const json& rows) {
+  Transform T;
+  for (int k = 0; k < 16; ++k) T(k / 4, k % 4) = rows[k / 4][k % 4].get<double>();
+  return T;
+}
+
 // The count per rung `map` closes with, from pairs.json's answered_by:
 // "31 prior, 5 features, 2 short, 1 full, 1 retry", rungs with none left out.
+
 std::string RungLine(const json& pairs) {
   const std::pair<const char*, const char*> ladder[] = {{"prior", "prior"},
                                                         {"features", "features"},
@@ -652,6 +660,41 @@ TEST_F(MapCli, AVlp16ReturnIsFoundByItsPlace) {
   EXPECT_GE(closed_by_place, 1);
 }
 
+// Two real VLP-16 scans 3 m apart (000099, 000100 of ../shared/data/vlp16_loop):
+// registered in the drive's direction the answer stays doubtful, but the
+// later scan explains more of the earlier than the earlier of it. The pair
+// registered the other way round is trusted, agrees with the first, and
+// bridges the chain: no scan is left without a trusted pair.
+TEST_F(MapCli, ADoubtfulPairIsBridgedByItselfTheOtherWayRound) {
+  const fs::path data = fs::path(BOICP_SHARED_DATA_DIR) / "vlp16_loop";
+  if (!fs::is_directory(data)) GTEST_SKIP() << "shared data not found at " << data;
+  const fs::path drive = dir_ / "vlp16_pair";
+  fs::create_directories(drive);
+  for (const char* name : {"000099.pcd", "000100.pcd"}) {
+    fs::create_symlink(data / "pcd" / name, drive / name);
+  }
+  const fs::path out = dir_ / "out";
+  const RunResult r = Run("map " + drive.string() + " -o " + out.string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["untrusted_scans"], json::array());
+  EXPECT_THAT(r.err, HasSubstr("1 of 1 doubtful chain pairs bridged by a trusted pair over them"));
+  std::map<std::string, json> pairs;
+  for (const json& pair : json::parse(Slurp(out / "pairs.json"))) {
+    pairs[std::to_string(pair["source"].get<int>()) + "->" +
+          std::to_string(pair["target"].get<int>())] = pair;
+  }
+  ASSERT_EQ(pairs.count("0->1"), 1u);
+  ASSERT_EQ(pairs.count("1->0"), 1u) << "the chain pair the other way round";
+  EXPECT_TRUE(pairs["0->1"]["doubtful"].get<bool>());
+  EXPECT_EQ(pairs["1->0"]["kind"], "bridge");
+  EXPECT_FALSE(pairs["1->0"]["doubtful"].get<bool>());
+  EXPECT_TRUE(pairs["1->0"]["in_graph"].get<bool>());
+  const Transform forward = TransformFromJson(pairs["0->1"]["transform"]);
+  const Transform backward = TransformFromJson(pairs["1->0"]["transform"]);
+  const double cycle = (forward * backward).topRightCorner<3, 1>().norm();
+  EXPECT_LT(cycle, 0.2) << "both directions find one answer";
+}
+
 // A drive whose scan 3 is noise: neither of its pairs can be trusted. The
 // bridge 2 -> 4 holds the chain together; scan 3 is named, kept in the
 // trajectory, and fused only with --untrusted-scans place.
@@ -681,6 +724,10 @@ TEST_F(MapCli, ADoubtfulScanIsBridgedNamedAndLeftOut) {
       bridges[std::to_string(pair["source"].get<int>()) + "->" +
               std::to_string(pair["target"].get<int>())] = pair;
     }
+  }
+  for (const char* reversed : {"3->2", "4->3"}) {
+    ASSERT_EQ(bridges.count(reversed), 1u) << "each doubtful pair the other way round, first";
+    EXPECT_TRUE(bridges[reversed]["doubtful"].get<bool>()) << reversed;
   }
   ASSERT_EQ(bridges.count("2->4"), 1u) << "the bridge one scan on from the first doubtful pair";
   EXPECT_FALSE(bridges["2->4"]["doubtful"].get<bool>());

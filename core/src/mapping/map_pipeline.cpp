@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -11,19 +12,43 @@
 namespace boicp {
 namespace {
 
+std::pair<int, int> Unordered(const PairIndex& p) {
+  return {std::min(p.source, p.target), std::max(p.source, p.target)};
+}
+
 // Where a bridge over a doubtful chain pair between scans low < high starts
-// and ends: `back` scans before low, `on` scans after high.
+// and ends: `back` scans before low, `on` scans after high; or, `reversed`,
+// the chain pair itself the other way round.
 struct BridgeOffset {
   int back = 0;
   int on = 0;
+  bool reversed = false;
 };
 
 // Tried in this order, each only over chain pairs no trusted bridge spans
-// yet: one scan back, one scan on, then both.
-constexpr BridgeOffset kBridgeOffsets[] = {{1, 0}, {0, 1}, {1, 1}};
+// yet: the pair reversed (the registration measures how much of the source
+// the target explains, and a sparse ring LiDAR's scan a few metres on may
+// explain less of the other than the other explains of it), one scan back,
+// one scan on, then both.
+constexpr BridgeOffset kBridgeOffsets[] = {
+    {0, 0, true}, {1, 0, false}, {0, 1, false}, {1, 1, false}};
 
-std::pair<int, int> Unordered(const PairIndex& p) {
-  return {std::min(p.source, p.target), std::max(p.source, p.target)};
+// The bridge `offset` puts over the chain pair `link`, if not registered yet.
+std::optional<PairIndex> BridgeOver(const PairIndex& link, const BridgeOffset& offset,
+                                    int num_scans, const RegisteredPairs& registered,
+                                    std::set<std::pair<int, int>>& registered_already) {
+  if (offset.reversed) {
+    const PairIndex reversed{link.target, link.source};
+    if (registered.finished.count(reversed) != 0) return std::nullopt;
+    return reversed;
+  }
+  const auto [low, high] = Unordered(link);
+  const PairIndex bridge{low - offset.back, high + offset.on};
+  if (bridge.source < 0 || bridge.target >= num_scans ||
+      !registered_already.insert(Unordered(bridge)).second) {
+    return std::nullopt;
+  }
+  return bridge;
 }
 
 // The grid every scan of the batch is described on: its radius the median
@@ -175,12 +200,10 @@ void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairSto
     PairingPlan plan = PlanFixedPairs(registered.chain, batch.plan.extras);
     std::vector<PairIndex> bridges;
     for (const PairIndex& link : open) {
-      const auto [low, high] = Unordered(link);
-      const PairIndex bridge{low - offset.back, high + offset.on};
-      if (bridge.source < 0 || bridge.target >= num_scans ||
-          !registered_already.insert(Unordered(bridge)).second) {
-        continue;
-      }
+      const std::optional<PairIndex> over =
+          BridgeOver(link, offset, num_scans, registered, registered_already);
+      if (!over) continue;
+      const PairIndex bridge = *over;
       plan.extras.push_back(bridge);
       plan.found_priors[bridge] = chained.poses[static_cast<size_t>(bridge.target)].inverse() *
                                   chained.poses[static_cast<size_t>(bridge.source)];

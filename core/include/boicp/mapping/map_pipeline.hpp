@@ -31,10 +31,11 @@ struct GraphEdges {
 GraphEdges GraphConstraints(const PairingPlan& plan, const RegisteredPairs& registered);
 
 /// The bridge stage of a batch whose plan is registered: where a chain pair
-/// is doubtful, the scans around it are registered directly, one scan back
-/// (low - 1 onto high), then one scan on (low onto high + 1), then both,
-/// each round only over chain pairs no trusted bridge spans yet, with the
-/// chain's relative pose as the prior and up to the short search. Bridges are stored in `store` and
+/// is doubtful, it is registered the other way round, then the scans
+/// around it are registered directly, one scan back (low - 1 onto high),
+/// one scan on (low onto high + 1), then both, each round only over chain
+/// pairs no trusted bridge spans yet, with the chain's relative pose as the
+/// prior and up to the short search. Bridges are stored in `store` and
 /// added to registered.finished and registered.bridges; a trusted one is an
 /// edge that the chain prefers to the doubtful pair. Throws what
 /// RegisterPlannedPairs throws.
