@@ -7,8 +7,9 @@
 #   50 pairs of another dataset: each KITTI 00 scan onto 5 VLP-16 scans;
 #   50 pairs of one drive with no overlap: VLP-16 scans 40-112 onto 300-348,
 #   stretches the drive never revisits (its revisits.csv);
-#   50 look-alike pairs: a generated street drive (demo-data --scans 150),
-#   scans 60-132 onto scans 50-90 m before them, beyond the 35 m range.
+#   50 look-alike pairs: a generated street drive (demo-data --scans 150,
+#   2 m a scan, 35 m range), scans 112-148 onto scans 72-104 m before them:
+#   the same kind of street, never the same stretch.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -42,8 +43,8 @@ for i in $(seq 40 8 112); do
     pairs+=("no-overlap|$(printf '%s/%06d.pcd' "$vlp" "$i")|$(printf '%s/%06d.pcd' "$vlp" "$j")")
   done
 done
-for i in $(seq 60 8 132); do
-  for back in 25 30 35 40 45; do
+for i in $(seq 112 4 148); do
+  for back in 36 40 44 48 52; do
     pairs+=("look-alike|$(printf '%s/scan_%03d.xyz' "$street" "$i")|$(printf '%s/scan_%03d.xyz' "$street" $((i - back)))")
   done
 done
