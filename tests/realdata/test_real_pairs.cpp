@@ -33,19 +33,42 @@ struct DatasetCase {
 
 std::ostream& operator<<(std::ostream& os, const DatasetCase& c) { return os << c.name; }
 
+// A dataset's reference pairs and how its scans load; `missing` says why
+// the test skips when the shared data is absent (then nothing else is read).
+struct SharedPairs {
+  std::string missing;
+  LoadOptions load;
+  std::vector<ReferencePair> pairs;
+};
+
+SharedPairs ReadSharedPairs(const DatasetCase& dataset) {
+  const std::filesystem::path folder = SharedDataFolder(dataset.name);
+  SharedPairs shared;
+  shared.missing = MissingSharedData(folder);
+  if (!shared.missing.empty()) return shared;
+  shared.load = SharedDataLoadOptions(folder, dataset.depth_images);
+  shared.pairs = ReadPairsCsv((folder / "pairs.csv").string());
+  return shared;
+}
+
+// Preset C on one thread, as every table of this file was measured.
+BoIcpConfig OneThreadConfigC() {
+  BoIcpConfig config = PresetConfig("C");
+  config.threads = 1;
+  return config;
+}
+
 // Registers every pair of `dataset` under `condition` with `budget` and
 // expects the dataset to pass (see the top of this file).
 void ExpectDatasetRecovered(const DatasetCase& dataset, Budget budget,
                             bench::FieldCondition condition) {
-  const std::filesystem::path folder = SharedDataFolder(dataset.name);
-  if (const std::string missing = MissingSharedData(folder); !missing.empty())
-    GTEST_SKIP() << missing;
-  const LoadOptions load = SharedDataLoadOptions(folder, dataset.depth_images);
-  BoIcpConfig config = PresetConfig("C");
-  config.threads = 1;
+  const SharedPairs shared = ReadSharedPairs(dataset);
+  if (!shared.missing.empty()) GTEST_SKIP() << shared.missing;
+  const LoadOptions& load = shared.load;
+  const std::vector<ReferencePair>& pairs = shared.pairs;
+  BoIcpConfig config = OneThreadConfigC();
   config.budget = budget;
 
-  const std::vector<ReferencePair> pairs = ReadPairsCsv((folder / "pairs.csv").string());
   std::mt19937_64 rng(20261122);
   std::mt19937_64 field_rng(20261204);  // its own, so the clean draws stay as they were
   int successes = 0, doubtful = 0, retried = 0, silent_failures = 0;
@@ -143,14 +166,12 @@ class RealPairsFromAGuess : public ::testing::TestWithParam<DatasetCase> {};
 
 TEST_P(RealPairsFromAGuess, NoAnswerFromTheIdentityGuessIsWrongAndTrusted) {
   const DatasetCase& dataset = GetParam();
-  const std::filesystem::path folder = SharedDataFolder(dataset.name);
-  if (const std::string missing = MissingSharedData(folder); !missing.empty())
-    GTEST_SKIP() << missing;
-  const LoadOptions load = SharedDataLoadOptions(folder, dataset.depth_images);
-  BoIcpConfig config = PresetConfig("C");
-  config.threads = 1;
+  const SharedPairs shared = ReadSharedPairs(dataset);
+  if (!shared.missing.empty()) GTEST_SKIP() << shared.missing;
+  const LoadOptions& load = shared.load;
+  const std::vector<ReferencePair>& pairs = shared.pairs;
+  BoIcpConfig config = OneThreadConfigC();
   config.seed = 20261207;
-  const std::vector<ReferencePair> pairs = ReadPairsCsv((folder / "pairs.csv").string());
   int right = 0;
   for (const ReferencePair& pair : pairs) {
     const RegistrationResult result = RegisterPair(LoadPointCloud(pair.source, load).points,
