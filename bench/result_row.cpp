@@ -29,11 +29,12 @@ std::string Text(const std::string& value) {
 }
 
 std::string Features(const std::optional<ConfidenceFeatures>& f) {
-  if (!f) return ",,,,,,,,";
+  if (!f) return ",,,,,,,,,";
   return Number(f->fitness) + ',' + Number(f->rmse_ratio) + ',' + Number(f->margin) + ',' +
          Number(f->support) + ',' + Number(f->probability_better) + ',' +
          Number(f->resolution_deg) + ',' + Number(f->seen_through) + ',' +
-         (f->margin_measured ? '1' : '0') + ',' + Number(f->constrained_share);
+         (f->margin_measured ? '1' : '0') + ',' + Number(f->constrained_share) + ',' +
+         Number(f->slide_rival);
 }
 
 }  // namespace
@@ -44,7 +45,7 @@ std::string FormatResultsCsv(const std::vector<ResultRow>& rows) {
          "source_points,target_points,evaluations,wall_s,rot_err_deg,trans_err_m,mean_p2p_m,"
          "overlap,success,confidence,icp_s,model_s,attempts,retry_s,fitness,rmse_ratio,margin,"
          "support,probability_better,resolution_deg,seen_through,margin_measured,constrained_share,"
-         "answered_by,"
+         "slide_rival,answered_by,"
          "error\n";
   for (const ResultRow& r : rows) {
     out << r.experiment << ',' << Text(r.dataset) << ',' << Text(r.source) << ',' << Text(r.target)
@@ -64,7 +65,7 @@ std::string FormatAttemptsCsv(const std::vector<ResultRow>& rows) {
   std::ostringstream out;
   out << "experiment,dataset,source,target,method,attempt,kind,mode,fitness,rmse_ratio,margin,"
          "support,probability_better,resolution_deg,seen_through,margin_measured,constrained_share,"
-         "confidence,"
+         "slide_rival,confidence,"
          "success,kept\n";
   for (const ResultRow& r : rows) {
     for (size_t k = 0; k < r.attempt_rows.size(); ++k) {

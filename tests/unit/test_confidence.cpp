@@ -166,5 +166,22 @@ TEST(Confidence, AnAnswerFreeAlongSomeDirectionIsDoubtful) {
   }
 }
 
+// An answer whose fit a slide off it keeps (a street of look-alike
+// stretches) is doubtful however well it fits, and trusted at none from
+// 0.92 on; at 0.88 or under, or unmeasured, it loses nothing.
+TEST(Confidence, AnAnswerWhoseFitASlideKeepsIsDoubtful) {
+  const ConfidenceFeatures best_fit = Features(0.9, 1.0, 0.1);
+  ASSERT_GT(Confidence(best_fit), 0.999);
+  ConfidenceFeatures f = best_fit;
+  f.slide_rival = 0.88;
+  EXPECT_EQ(Confidence(f), Confidence(best_fit));
+  f.slide_rival = 0.9;
+  EXPECT_LT(Confidence(f), kTrustedFrom);
+  for (const double rival : {0.92, 1.1}) {  // 1.1: a slide fits better than the answer
+    f.slide_rival = rival;
+    EXPECT_EQ(Confidence(f), 0.0) << rival;
+  }
+}
+
 }  // namespace
 }  // namespace boicp

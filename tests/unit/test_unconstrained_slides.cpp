@@ -1,10 +1,12 @@
-// Which slides a pair's matched surfaces leave free, and what that does to
-// the answer's confidence (core/icp/unconstrained_slides).
+// Which slides a pair's matched surfaces leave free, whether the fit holds
+// along the weakest, and what that does to the answer's confidence
+// (core/icp/unconstrained_slides, core/icp/slide_rival).
 
 #include <algorithm>
 
 #include <gtest/gtest.h>
 
+#include "boicp/icp/slide_rival.hpp"
 #include "boicp/icp/unconstrained_slides.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/mapping/pose_graph.hpp"
@@ -121,6 +123,81 @@ TEST(UnconstrainedSlides, ACorridorPairIsDoubtfulAndNamesItsFreeSlide) {
   EXPECT_LT(RotationErrorDeg(result.transform, truth), 1.0);
   EXPECT_LT(std::abs(result.transform(1, 3)), 0.05);
   EXPECT_LT(std::abs(result.transform(2, 3)), 0.05);
+}
+
+// SlideRivalShare: whether the answer is the only place its surfaces fit
+// along its weakest slide.
+
+Points Within(const Points& points, double half_length) {
+  Points out;
+  for (const Point& p : points)
+    if (std::abs(p.x()) < half_length) out.push_back(p);
+  return out;
+}
+
+// Along a corridor the source fits wherever it stops; across it, the walls
+// leave and only the floor stays.
+TEST(SlideRival, ACorridorKeepsItsFitAlongItButNotAcross) {
+  const Points target = Corridor(40.0);
+  const Points source = Within(target, 10.0);
+  const NearestNeighborIndex index(target);
+  EXPECT_GT(SlideRivalShare(source, index, Transform::Identity(), Point::UnitX(), 0.05), 0.98);
+  EXPECT_LT(SlideRivalShare(source, index, Transform::Identity(), Point::UnitY(), 0.05), 0.6);
+}
+
+// Posts every 0.5 m along the corridor pin a right answer: a slide moves
+// them off, whatever else stays.
+TEST(SlideRival, PostsAlongACorridorPinTheAnswer) {
+  Points target = Corridor(40.0);
+  for (double x = -20.0; x <= 20.0; x += 4.0) {
+    for (double z = 0.0; z <= 2.5; z += 0.02) {
+      for (double a = 0.0; a < 2 * M_PI; a += 0.3)
+        target.push_back({x + 0.4 * std::cos(a), 0.4 * std::sin(a), z});
+    }
+  }
+  const Points source = Within(target, 10.0);
+  const double rival = SlideRivalShare(source, NearestNeighborIndex(target), Transform::Identity(),
+                                       Point::UnitX(), 0.05);
+  EXPECT_LT(rival, 0.88);
+}
+
+// A source that fits nowhere has no rival to measure, and neither has one
+// too short to slide.
+TEST(SlideRival, NothingToSlideIsZero) {
+  const Points target = Corridor(10.0);
+  const NearestNeighborIndex index(target);
+  EXPECT_EQ(
+      SlideRivalShare(target, index, PoseFromYawTranslation(0.0, {0, 0, 50}), Point::UnitX(), 0.05),
+      0.0);
+  const Points post = {{0, 0, 0}, {0.01, 0, 0}, {0, 0, 1}};
+  EXPECT_EQ(SlideRivalShare(post, index, Transform::Identity(), Point::UnitX(), 0.05), 0.0);
+}
+
+// Two stretches of the generated street 80 m apart, with the chain's
+// "same place" as the prior: ground and facades fit at the prior, as they
+// would a block further on, and the registration used to trust it. The
+// same scan onto its neighbour is pinned by poles and cars, and trusted.
+TEST(SlideRival, ALookAlikeStreetIsDoubtfulAndItsNeighbourTrusted) {
+  const SyntheticDrive drive(150, 7);
+  const SyntheticScan later = drive.Scan(124), earlier = drive.Scan(84), next = drive.Scan(123);
+  const BoIcpConfig config = PresetConfig("C");
+  const RegistrationResult alike =
+      RegisterPair(later.points, earlier.points, config, Transform::Identity());
+  const Transform truth = earlier.T_world_scan.inverse() * later.T_world_scan;
+  ASSERT_GT(TranslationErrorM(alike.transform, truth), 50.0);
+  EXPECT_GT(alike.features.slide_rival, 0.92);
+  EXPECT_TRUE(alike.doubtful) << alike.confidence;
+  ConfidenceFeatures unprobed = alike.features;
+  unprobed.slide_rival = 0.0;
+  EXPECT_GE(Confidence(unprobed), kTrustedFrom) << "the probe is what makes it doubtful";
+
+  const RegistrationResult neighbour =
+      RegisterPair(later.points, next.points, config, Transform::Identity());
+  EXPECT_LT(
+      TranslationErrorM(neighbour.transform, next.T_world_scan.inverse() * later.T_world_scan),
+      0.1);
+  EXPECT_LT(neighbour.features.slide_rival, 0.88);
+  EXPECT_FALSE(neighbour.doubtful) << neighbour.confidence;
 }
 
 }  // namespace

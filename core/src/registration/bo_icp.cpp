@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "boicp/icp/slide_rival.hpp"
+#include "boicp/icp/unconstrained_slides.hpp"
 #include "boicp/registration/auto_settings.hpp"
 #include "boicp/registration/confidence.hpp"
 #include "boicp/registration/feature_hypotheses.hpp"
@@ -411,6 +413,12 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   result.probability_better = kept.probability_better;
   result.features = kept.features;
   result.features.constrained_share = ConstrainedShare(information);
+  const std::vector<FreeSlide> slides =
+      PrincipalSlides(information, config.EffectiveInlierDistance());
+  if (!slides.empty())
+    result.features.slide_rival =
+        SlideRivalShare(finest.source, finest.target, kept.refined.transform, slides.front().axis,
+                        config.EffectiveInlierDistance());
   result.confidence = std::min(kept.confidence, Confidence(result.features));
   result.doubtful = result.confidence < kTrustedFrom;
   result.gp_mean = kept.gp_mean;

@@ -47,6 +47,14 @@ constexpr double kSeenThroughOfFullTrust = 0.15;
 // real scans hold their weakest slide more firmly (bench/README.md).
 constexpr double kConstrainedShareOfFullTrust = 1.06 * kUnconstrainedShare;
 constexpr double kConstrainedShareOfNoTrust = 0.5 * kUnconstrainedShare;
+// An answer whose fit survives a slide off it (slide_rival near 1) is one
+// spot of many where its surfaces fit: a street's ground and facades fit a
+// block further on as well. Trust falls from full at kSlideRivalOfFullTrust
+// to none at kSlideRivalOfNoTrust. Right answers keep less of their fit;
+// bench/README.md has both sides and how the line does on each dataset
+// held out.
+constexpr double kSlideRivalOfFullTrust = 0.88;
+constexpr double kSlideRivalOfNoTrust = 0.92;
 
 // A cap that rises linearly from 0 where `value` is `no_trust` to 1 where it
 // is `full_trust` (either way round), and stays there beyond.
@@ -67,8 +75,10 @@ double Confidence(const ConfidenceFeatures& f) {
       TrustBetween(f.seen_through, kSeenThroughOfNoTrust, kSeenThroughOfFullTrust);
   const double free_slide_cap =
       TrustBetween(f.constrained_share, kConstrainedShareOfNoTrust, kConstrainedShareOfFullTrust);
+  const double slide_rival_cap =
+      TrustBetween(f.slide_rival, kSlideRivalOfNoTrust, kSlideRivalOfFullTrust);
   return std::min({model, std::max(f.fitness, 0.0) / kFitnessOfFullTrust, tie_cap, seen_through_cap,
-                   free_slide_cap});
+                   free_slide_cap, slide_rival_cap});
 }
 
 }  // namespace boicp

@@ -1,5 +1,5 @@
 #pragma once
-// Order statistics shared by the settings rules and the map preview.
+// Order statistics shared across core.
 
 #include <algorithm>
 #include <cstddef>

@@ -8,7 +8,7 @@ namespace boicp {
 
 /// What the engine knows about its own answer when it finishes. The model
 /// weighs fitness, log(margin) and resolution; fitness, a measured margin and
-/// seen_through and constrained_share cap it; the rest is reported for
+/// seen_through, constrained_share and slide_rival cap it; the rest is reported for
 /// fitting and diagnosis.
 struct ConfidenceFeatures {
   double fitness = 0.0;          // inlier fraction at the finest level, in [0, 1]
@@ -26,6 +26,9 @@ struct ConfidenceFeatures {
   /// least constrained slide is held; 1 where not measured (a
   /// rung's own attempts: the result measures its answer's).
   double constrained_share = 1.0;
+  /// SlideRivalShare along the answer's least constrained slide: how much
+  /// of its fitness a slide off it keeps; 0 where not measured.
+  double slide_rival = 0.0;
 };
 
 /// The seen_through share from which an answer has no trust at all: it puts
@@ -36,9 +39,10 @@ constexpr double kSeenThroughOfNoTrust = 0.3;
 /// thresholds (2 degrees, and a few refinement voxels of translation); 0
 /// with no inliers, under 0.5 with fitness under 0.05, a measured margin
 /// under 0.02 or seen_through over 0.225, under 0.95 with
-/// constrained_share under kUnconstrainedShare (an unconstrained direction),
-/// and 0 with a measured margin of 0.01 or less, seen_through of 0.3 or more
-/// or constrained_share of half kUnconstrainedShare or less.
+/// constrained_share under kUnconstrainedShare (an unconstrained direction)
+/// or slide_rival over 0.88 (a slide keeps the fit), and 0 with a measured
+/// margin of 0.01 or less, seen_through of 0.3 or more, constrained_share of
+/// half kUnconstrainedShare or less or slide_rival of 0.92 or more.
 double Confidence(const ConfidenceFeatures& features);
 
 }  // namespace boicp
