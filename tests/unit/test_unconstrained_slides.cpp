@@ -145,12 +145,13 @@ TEST(SlideRival, ACorridorKeepsItsFitAlongItButNotAcross) {
   EXPECT_LT(SlideRivalShare(source, index, Transform::Identity(), Point::UnitY(), 0.05), 0.6);
 }
 
-// Posts every 0.5 m along the corridor pin a right answer: a slide moves
-// them off, whatever else stays.
+// Posts at irregular places along the corridor pin a right answer: a slide
+// moves them off, whatever else stays. (Evenly spaced posts would fit again
+// a spacing further on.)
 TEST(SlideRival, PostsAlongACorridorPinTheAnswer) {
   Points target = Corridor(40.0);
-  for (double x = -20.0; x <= 20.0; x += 4.0) {
-    for (double z = 0.0; z <= 2.5; z += 0.02) {
+  for (const double x : {-17.3, -11.1, -6.4, -2.2, 3.7, 8.9, 12.6, 18.2}) {
+    for (double z = 0.0; z <= 2.5; z += 0.025) {
       for (double a = 0.0; a < 2 * M_PI; a += 0.3)
         target.push_back({x + 0.4 * std::cos(a), 0.4 * std::sin(a), z});
     }
@@ -158,7 +159,7 @@ TEST(SlideRival, PostsAlongACorridorPinTheAnswer) {
   const Points source = Within(target, 10.0);
   const double rival = SlideRivalShare(source, NearestNeighborIndex(target), Transform::Identity(),
                                        Point::UnitX(), 0.05);
-  EXPECT_LT(rival, 0.88);
+  EXPECT_LT(rival, 0.8);
 }
 
 // A source that fits nowhere has no rival to measure, and neither has one
