@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The drive bench (issue 54): every real sequence of the shared data with
+# The drive bench: every real sequence of the shared data with
 # reference poses, mapped by `boicp map` (defaults) at strides 1, 2, 5 and
 # 10, every pair scored against the sequence's own poses polished by one ICP
 # (bench/drives_report.py) and the trajectory by `boicp eval` -> OUT/drives.md.

@@ -76,7 +76,7 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 }
 
 // OctoMap's insertPointCloud(discretize = true, lazy_eval = true) on every
-// scan, then the .bt: the fusion before issue 19.
+// scan, then the .bt: the plain fusion the batched one is measured against.
 double FuseWithOctoMapInsertion(const std::vector<boicp::ScanSource>& scans,
                                 const std::vector<Transform>& poses,
                                 const boicp::OccupancySettings& s, const std::string& bt_path) {

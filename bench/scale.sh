@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# How boicp scales with the length of a drive (issue 19). Generated drives of
+# How boicp scales with the length of a drive. Generated drives of
 # each length (boicp demo-data --scans N) go through the one-process
 # `boicp map` and through the daemon (boicpd on a free loopback port, a fresh
 # one per drive, then boicp submit / watch / export). For each run it records

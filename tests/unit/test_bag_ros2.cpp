@@ -1,4 +1,4 @@
-// ROS 2 bags (issue 33): .db3 folders and .mcap files written by the test
+// ROS 2 bags: .db3 folders and .mcap files written by the test
 // writers read back the same through OpenBag, whatever the chunking,
 // compression and summary; malformed files are refused with an InputError
 // that names the file.

@@ -172,7 +172,7 @@ RefinedAlignment RefineCoarseToFine(const std::vector<Transform>& starts, const 
   // One run at a time (each may stop on its leader's score), so the threads
   // go to its nearest-neighbour searches, which do not change the result.
   options.threads = config.threads;
-  // The fixed budget refines exactly as the paper-era engine did: every
+  // The fixed budget refines exactly as the paper's engine does: every
   // level until its steps are below 1/1000 voxel and 1e-4 rad (the search's
   // 1/100 voxel and 1e-3 rad cost the bunny 0.2-0.5 degrees and one flipped
   // pair). The ladder jumps along the steps ICP creeps by, which lets it stop
