@@ -176,8 +176,9 @@ TEST(SlideRival, NothingToSlideIsZero) {
 
 // Two stretches of the generated street 80 m apart, with the chain's
 // "same place" as the prior: ground and facades fit at the prior, as they
-// would a block further on, and the registration used to trust it. The
-// same scan onto its neighbour is pinned by poles and cars, and trusted.
+// would a block further on, well enough for the fit alone to be trusted.
+// The same scan onto its neighbour is pinned by poles and cars, and
+// trusted.
 TEST(SlideRival, ALookAlikeStreetIsDoubtfulAndItsNeighbourTrusted) {
   const SyntheticDrive drive(150, 7);
   const SyntheticScan later = drive.Scan(124), earlier = drive.Scan(84), next = drive.Scan(123);
