@@ -24,6 +24,7 @@ struct ExportFlags {
   std::string job_id, format, output;
   std::string sensor_up;  // "x,y,z" in the scan frame; empty = unknown
   bool preview = true;
+  uint32_t drive = 0;  // a trajectory of this drive alone (1-based); 0 = every scan
 };
 
 struct ExportKind {
@@ -56,7 +57,11 @@ std::pair<ExportKind, std::string> ResolveFormat(const ExportFlags& f) {
     if (f.output.empty()) throw InputError("--format: needed when -o is not given" + choices);
     throw InputError("--format: not implied by -o '" + f.output + "'" + choices);
   }
-  return {found->second, f.output.empty() ? found->second.default_name : f.output};
+  std::string output = f.output;
+  if (output.empty() && f.drive > 0) {
+    output = "trajectory-drive" + std::to_string(f.drive) + "." + name;
+  }
+  return {found->second, output.empty() ? found->second.default_name : output};
 }
 
 // The job's poses for the preview, through a KITTI trajectory export:
@@ -96,7 +101,7 @@ int RunExport(const ExportFlags& f) {
   if (!parent.empty()) fs::create_directories(parent);
   uint64_t bytes = 0;
   WriteFileAtomically(output, [&](const std::string& tmp) {
-    bytes = daemon.client->ExportToFile(f.job_id, kind.format, tmp);
+    bytes = daemon.client->ExportToFile(f.job_id, kind.format, tmp, f.drive);
   });
   std::fprintf(stderr, "wrote %s (%llu bytes)\n", output.c_str(),
                static_cast<unsigned long long>(bytes));
@@ -124,6 +129,10 @@ CommandRunner AddExportCommand(CLI::App& app) {
       "File to write (atomically: a staging file, then renamed); default: map.bt, map.ot, "
       "map.ply, trajectory.tum or trajectory.kitti");
   app.add_option("--sensor-up", flags->sensor_up, kSensorUpHelp);
+  app.add_option("--drive", flags->drive,
+                 "tum or kitti of a job of several drives: drive K's scans only (1-based; "
+                 "default file trajectory-driveK.tum or .kitti); 0 = every scan")
+      ->capture_default_str();
   app.add_flag("!--no-preview", flags->preview,
                "For bt/ot, skip the top-down preview PNG written next to FILE (FILE with .png)");
   AddRemoteOptions(app, flags->remote);

@@ -29,6 +29,27 @@ MapOutputPaths LocalOutputPaths(const std::string& out_dir) {
   return paths;
 }
 
+// Each drive's trajectory files' stem in OUTDIR: "trajectory" for one
+// drive; of several, "trajectory-NAME", NAME its folder's or bag's name
+// (numbered from 1 when two drives share one).
+std::vector<std::string> DriveTrajectoryStems(const LocalRun& run) {
+  if (run.drives.size() == 1) return {"trajectory"};
+  std::vector<std::string> names;
+  for (const LocalDrive& drive : run.drives) {
+    fs::path path = fs::path(drive.path).lexically_normal();
+    if (!path.has_filename()) path = path.parent_path();  // "folder/"
+    names.push_back(path.stem().string());
+  }
+  const std::set<std::string> distinct(names.begin(), names.end());
+  std::vector<std::string> stems;
+  for (size_t d = 0; d < names.size(); ++d) {
+    const std::string name =
+        distinct.size() == names.size() ? names[d] : std::to_string(d + 1) + "-" + names[d];
+    stems.push_back("trajectory-" + name);
+  }
+  return stems;
+}
+
 // The pairs pairs.json lists: a fixed plan's, in plan order, then the
 // bridges and the loop candidates; for keyframes every pair, in index order.
 std::vector<PairIndex> ListedPairs(const PairingPlan& plan, const RegisteredPairs& registered) {
@@ -65,6 +86,13 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
     listing.push_back(PairListingJson(run.batch.scans, r));
   }
   WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
+  if (run.drives.size() > 1) {
+    std::vector<std::string> stems;
+    for (const std::string& stem : DriveTrajectoryStems(run))
+      stems.push_back((dir / stem).string());
+    WriteDriveTrajectories(run.batch.scans, map.estimate.poses, run.batch.pairing.drive_starts,
+                           stems);
+  }
 
   MapOutputSummary summary;
   summary.poses = map.estimate.poses;
@@ -155,6 +183,21 @@ nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summa
        {"map.bt", "map.ot", "trajectory.tum", "trajectory.kitti", "pairs.json", "preview.png"}) {
     outputs[name] = (fs::path(out_dir) / name).string();
   }
+  // Each drive with its trajectory files' names; several drives' files are
+  // outputs too.
+  json drives = json::array();
+  const std::vector<std::string> stems = DriveTrajectoryStems(run);
+  for (size_t d = 0; d < run.drives.size(); ++d) {
+    for (const char* extension : {".tum", ".kitti"}) {
+      const std::string name = stems[d] + extension;
+      outputs[name] = (fs::path(out_dir) / name).string();
+    }
+    drives.push_back({{"path", run.drives[d].path},
+                      {"first_scan", run.drives[d].first_scan},
+                      {"scans", run.drives[d].scans},
+                      {"trajectory_tum", stems[d] + ".tum"},
+                      {"trajectory_kitti", stems[d] + ".kitti"}});
+  }
   return {{"layout", ScanLayoutName(run.layout)},
           {"scans", run.batch.scans.size()},
           {"pairs", summary.pairs},
@@ -169,7 +212,8 @@ nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summa
           {"pose_graph_optimised", summary.optimised},
           {"occupied_leaves", summary.occupied_leaves},
           {"runtime_s", seconds},
-          {"outputs", outputs}};
+          {"outputs", outputs},
+          {"drives", drives}};
 }
 
 int RegisterLocalPairs(const LocalRun& run, const std::vector<PairIndex>& pairs,

@@ -41,6 +41,7 @@ ScanFolderOptions FolderOptions(const MapSettings& s) {
 json MapSettingsToJson(const MapSettings& s) {
   json out = settings::SettingsToJson(s, settings::kMap);
   out.update({{"path", s.path},
+              {"more_paths", s.more_paths},
               {"layout", s.layout},
               {"pairing", s.pairing},
               {"pairs_file", s.pairs_file},
@@ -66,6 +67,8 @@ MapSettings MapSettingsFromJson(const json& j, const std::string& source) {
   settings::SettingsFromJson(j, settings::kMap, source, s);
   try {
     s.path = j.at("path").get<std::string>();
+    // Runs of one drive written before several were read had none.
+    s.more_paths = j.value("more_paths", std::vector<std::string>());
     s.layout = j.at("layout").get<std::string>();
     s.pairing = j.at("pairing").get<std::string>();
     s.pairs_file = j.at("pairs_file").get<std::string>();
@@ -139,21 +142,33 @@ PairingRequest PairingOfSettings(const MapSettings& settings) {
   return pairing;
 }
 
-// The run of `folder`'s scans (from `where`) with `settings`.
-LocalRun RunOfScans(const MapSettings& settings, ScanFolder folder, const std::string& where) {
+// The run of the scans of `folders` (each a drive, read from `wheres`)
+// with `settings`.
+LocalRun RunOfScans(const MapSettings& settings, std::vector<ScanFolder> folders,
+                    const std::vector<std::string>& wheres) {
   LocalRun run;
   run.settings = settings;
-  const int n = static_cast<int>(folder.scans.size());
-  if (n < 2) {
-    throw InputError(where + ": a map needs at least 2 scans, the selection has " +
-                     std::to_string(n));
+  std::vector<ScanSource> scans;
+  PairingRequest pairing = PairingOfSettings(settings);
+  for (size_t d = 0; d < folders.size(); ++d) {
+    ScanFolder& folder = folders[d];
+    const int n = static_cast<int>(folder.scans.size());
+    if (n < 2) {
+      throw InputError(wheres[d] + ": a " + (folders.size() > 1 ? "drive" : "map") +
+                       " needs at least 2 scans, the selection has " + std::to_string(n));
+    }
+    const int first = static_cast<int>(scans.size());
+    if (d > 0) pairing.drive_starts.push_back(first);
+    run.drives.push_back({wheres[d], first, n});
+    run.description += (d > 0 ? "; " : "") +
+                       (folders.size() > 1 ? wheres[d] + ": " : std::string()) + folder.description;
+    for (ScanSource& scan : folder.scans) scans.push_back(std::move(scan));
   }
-  run.layout = folder.layout;
-  run.description = std::move(folder.description);
+  run.layout = folders.front().layout;
   // Parallelism is across pairs; inside one registration it is one thread,
   // as the daemon's default --registration-threads.
   run.batch = boicp::settings::MakeMapBatch(
-      std::move(folder.scans), settings, PairingOfSettings(settings), 1,
+      std::move(scans), settings, std::move(pairing), 1,
       settings.pairing == "explicit" ? settings.pairs_file : settings.extra_pairs_file);
   return run;
 }
@@ -161,12 +176,19 @@ LocalRun RunOfScans(const MapSettings& settings, ScanFolder folder, const std::s
 }  // namespace
 
 LocalRun PrepareRun(const MapSettings& settings) {
-  return RunOfScans(settings, ReadScanFolder(settings.path, FolderOptions(settings)),
-                    settings.path);
+  std::vector<std::string> paths = {settings.path};
+  paths.insert(paths.end(), settings.more_paths.begin(), settings.more_paths.end());
+  std::vector<ScanFolder> folders;
+  for (const std::string& path : paths) {
+    folders.push_back(ReadScanFolder(path, FolderOptions(settings)));
+  }
+  return RunOfScans(settings, std::move(folders), paths);
 }
 
 LocalRun PrepareRun(const MapSettings& settings, const std::vector<std::string>& files) {
-  return RunOfScans(settings, ReadScanList(files, FolderOptions(settings)), "the list of scans");
+  std::vector<ScanFolder> folders;
+  folders.push_back(ReadScanList(files, FolderOptions(settings)));
+  return RunOfScans(settings, std::move(folders), {"the list of scans"});
 }
 
 MapSettings WithAbsolutePaths(MapSettings settings) {
@@ -174,6 +196,7 @@ MapSettings WithAbsolutePaths(MapSettings settings) {
     if (!path.empty()) path = fs::absolute(path).lexically_normal().string();
   };
   absolute(settings.path);
+  for (std::string& path : settings.more_paths) absolute(path);
   absolute(settings.pairs_file);
   absolute(settings.extra_pairs_file);
   return settings;

@@ -26,6 +26,9 @@ namespace boicp::cli {
 /// rest say which scans to read and how to pair them.
 struct MapSettings : settings::RequestedSettings {
   std::string path;  // scan folder or bag (made absolute)
+  /// Further drives of the same place, each a folder or bag read as `path`
+  /// is; mapped into path's first scan's frame (drives.hpp).
+  std::vector<std::string> more_paths;
   std::string layout = "auto";
   std::string pairing = "consecutive";  // PairingModeName: consecutive | overlap | explicit
   std::string pairs_file;               // explicit pairing: "source,target" lines
@@ -43,9 +46,17 @@ nlohmann::json MapSettingsToJson(const MapSettings& settings);
 /// Throws InputError naming `source` when a field is missing or mistyped.
 MapSettings MapSettingsFromJson(const nlohmann::json& json, const std::string& source);
 
+/// One drive of a run: its folder or bag and its scans in batch.scans.
+struct LocalDrive {
+  std::string path;
+  int first_scan = 0;
+  int scans = 0;
+};
+
 /// A run resolved from its settings.
 struct LocalRun {
   MapSettings settings;
+  std::vector<LocalDrive> drives;         // settings.path's, then more_paths'; one for one drive
   ScanLayout layout = ScanLayout::kAuto;  // the folder's layout (never kAuto)
   std::string description;                // the folder in one line (ScanFolder::description)
   MapBatch batch;                         // one thread per registration

@@ -34,9 +34,10 @@ void AddFusionLimitFlag(CLI::App& app, uint64_t& max_fusion_mb) {
 void AddMapSettingsFlags(CLI::App& app, MapSettingsFlags& flags, settings::Frontend frontend) {
   MapSettings& s = flags.settings;
   flags.frontend = frontend;
-  app.add_option("PATH", s.path,
+  app.add_option("PATH", flags.paths,
                  "Scan folder (KITTI, TUM, 7-Scenes, or .pcd/.ply/.xyz files) or bag (ROS 1 "
-                 ".bag, ROS 2 .mcap, .db3 or bag folder)");
+                 ".bag, ROS 2 .mcap, .db3 or bag folder); several: drives of one place, "
+                 "mapped into the first's frame");
   app.add_option("--layout", s.layout, "auto, kitti, tum, 7scenes, files or bag")
       ->capture_default_str();
   app.add_option("--pairing", flags.pairing_words,
@@ -72,14 +73,17 @@ MapSettings ResolveMapSettings(const MapSettingsFlags& flags) {
   s.pairing = words[0];
   size_t used = 1;
   if (s.pairing == "explicit" && words.size() > 1) s.pairs_file = words[used++];
+  std::vector<std::string> paths = flags.paths;
   if (words.size() > used) {
-    if (!s.path.empty() || words.size() > used + 1) {
+    if (!paths.empty()) {
       throw InputError("--pairing: unexpected '" + words[used] +
                        "' (consecutive, overlap or explicit FILE)");
     }
-    s.path = words[used];
+    paths.assign(words.begin() + static_cast<std::ptrdiff_t>(used), words.end());
   }
-  if (s.path.empty()) throw InputError("PATH: the folder of scans is required");
+  if (paths.empty()) throw InputError("PATH: the folder of scans is required");
+  s.path = paths.front();
+  s.more_paths.assign(paths.begin() + 1, paths.end());
   if (s.stride != 1 && s.bag.min_interval > 0.0) {
     throw InputError("--every and --min-interval: give one of them");
   }

@@ -21,6 +21,7 @@ struct MapSettingsFlags {
   settings::FlagTexts setting_texts;
   settings::Frontend frontend = settings::kMap;
   std::vector<std::string> pairing_words = {"consecutive"};
+  std::vector<std::string> paths;  // PATH: one, or several drives
 };
 
 /// Registers PATH and the shared flags on `app`, with the settings the

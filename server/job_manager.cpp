@@ -134,6 +134,7 @@ v1::Job JobManager::Submit(const v1::SubmitBatchRequest& request) {
   job.set_state(v1::JOB_STATE_QUEUED);
   rpc::SetJobStage(job, v1::JOB_STAGE_QUEUED);
   job.set_num_scans(static_cast<uint32_t>(request.scan_ids_size()));
+  job.set_drives(static_cast<uint32_t>(request.pairing().drive_starts_size() + 1));
   // A keyframe plan registers at least one pair per scan after the first.
   const size_t planned = (batch.plan.keyframes ? batch.scans.size() - 1 : batch.plan.chain.size()) +
                          batch.plan.extras.size();

@@ -6,7 +6,18 @@
 
 namespace boicp::server {
 
-std::optional<std::string> ExportFileName(int format) {
+namespace {
+
+std::string DriveStem(uint32_t drive) { return "trajectory-drive" + std::to_string(drive); }
+
+}  // namespace
+
+std::optional<std::string> ExportFileName(int format, uint32_t drive) {
+  if (drive > 0) {
+    if (format == ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_TUM) return DriveStem(drive) + ".tum";
+    if (format == ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_KITTI) return DriveStem(drive) + ".kitti";
+    return std::nullopt;
+  }
   switch (format) {
     case ::boicp::v1::EXPORT_FORMAT_OCTOMAP_BT:
       return "map.bt";
@@ -21,6 +32,14 @@ std::optional<std::string> ExportFileName(int format) {
     default:
       return std::nullopt;
   }
+}
+
+std::vector<std::string> DriveTrajectoryStems(const std::string& job_dir, size_t drives) {
+  std::vector<std::string> stems;
+  for (size_t d = 1; d <= drives; ++d) {
+    stems.push_back(job_dir + "/" + DriveStem(static_cast<uint32_t>(d)));
+  }
+  return stems;
 }
 
 MapOutputPaths JobOutputPaths(const std::string& job_dir) {

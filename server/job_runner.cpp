@@ -248,9 +248,15 @@ class JobRun : public MapProgressSink {
 
   // ---- Endings -------------------------------------------------------------
   RunOutcome Finish(const MapPipelineResult& result) {
-    const MapOutputPaths outputs = JobOutputPaths(ctx_.data_dir.JobDir(job_.job_id()));
+    const std::string job_dir = ctx_.data_dir.JobDir(job_.job_id());
+    const MapOutputPaths outputs = JobOutputPaths(job_dir);
     RequireOutputsWritten(outputs);
     const AssembledMap& map = result.map;
+    const std::vector<int>& drive_starts = spec_.batch.pairing.drive_starts;
+    if (!drive_starts.empty()) {
+      WriteDriveTrajectories(spec_.batch.scans, map.estimate.poses, drive_starts,
+                             DriveTrajectoryStems(job_dir, drive_starts.size() + 1));
+    }
     spdlog::info(
         "job {} fused {} scans in {:.1f} s: {} occupied leaves, {} cloud points", job_.job_id(),
         spec_.batch.scans.size() - (map.untrusted_left_out ? map.untrusted_scans.size() : 0),

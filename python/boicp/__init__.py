@@ -136,7 +136,8 @@ def build_map(folder, out_dir, *, progress=None, threads=0, max_fusion_mb=0, **s
     settings: the map's settings by name (config, voxel, resolution,
         max_range, ...) and run.json's folder and pairing keys (layout,
         first, stride, count, pairing, pairs_file, overlap_threshold,
-        extra_pairs_file, intrinsics, camera, depth_scale, poses_as_priors)
+        extra_pairs_file, intrinsics, camera, depth_scale, poses_as_priors,
+        more_paths: further drives of the same place, as ``boicp map A B``)
         and, for a bag, topic, odometry_topic, start, duration and
         min_interval.
     """

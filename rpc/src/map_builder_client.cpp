@@ -204,12 +204,13 @@ v1::Job MapBuilderClient::Watch(const std::string& job_id,
 }
 
 uint64_t MapBuilderClient::ExportToFile(const std::string& job_id, v1::ExportFormat format,
-                                        const std::string& path) {
+                                        const std::string& path, uint32_t drive) {
   grpc::ClientContext context;
   Authorize(context);
   v1::ExportRequest request;
   request.set_job_id(job_id);
   request.set_format(format);
+  request.set_drive(drive);
   auto reader = stub_->Export(&context, request);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error(path + ": cannot write");

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -179,6 +180,12 @@ PairingRequest PairingFromProto(const v1::PairingPolicy& proto) {
   for (const v1::Pair& p : proto.pairs()) {
     pairing.pairs.push_back({static_cast<int>(p.source()), static_cast<int>(p.target())});
   }
+  for (const uint32_t start : proto.drive_starts()) {
+    if (start > static_cast<uint32_t>(std::numeric_limits<int>::max())) {
+      throw InputError("pairing.drive_starts: " + std::to_string(start) + " is no scan index");
+    }
+    pairing.drive_starts.push_back(static_cast<int>(start));
+  }
   return pairing;
 }
 
@@ -193,6 +200,7 @@ v1::PairingPolicy PairingToProto(const PairingRequest& pairing) {
     pair->set_source(static_cast<uint32_t>(p.source));
     pair->set_target(static_cast<uint32_t>(p.target));
   }
+  for (const int start : pairing.drive_starts) proto.add_drive_starts(static_cast<uint32_t>(start));
   return proto;
 }
 

@@ -111,6 +111,19 @@ class MapCli : public ::testing::Test {
     return scans;
   }
 
+  // Moves MakeDrive's scans from `first` on into a folder `name` of their
+  // own: a second drive of the same street.
+  fs::path SplitDrive(const fs::path& drive, int first, const std::string& name) {
+    const fs::path second = dir_ / name;
+    fs::create_directories(second);
+    for (size_t i = static_cast<size_t>(first); i < truth_.size(); ++i) {
+      char file[32];
+      std::snprintf(file, sizeof(file), "scan%03zu.xyz", i);
+      fs::rename(drive / file, second / file);
+    }
+    return second;
+  }
+
   fs::path dir_;
   std::vector<Transform> truth_;  // T_world_scan of MakeDrive's scans
 };
@@ -295,6 +308,8 @@ TEST_F(MapCli, GeneratedDriveWritesEveryOutputAndRerunsReusePairs) {
   EXPECT_EQ(summary["pairs"], 3);
   EXPECT_EQ(summary["pairs_reused"], 0);
   EXPECT_EQ(summary["layout"], "files");
+  ASSERT_EQ(summary["drives"].size(), 1u);
+  EXPECT_EQ(summary["drives"][0]["trajectory_kitti"], "trajectory.kitti");
   EXPECT_THAT(r.err, HasSubstr("(3/3)")) << "progress goes to stderr";
 
   octomap::OcTree tree(0.1);
@@ -598,11 +613,16 @@ TEST_F(MapCli, SevenScenesDriveClosesItsOwnLoops) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return json::parse(r.out)["trajectory"]["ate_rmse_m"].get<double>();
   };
-  const fs::path chain = dir_ / "chain", looped = dir_ / "looped";
-  ASSERT_EQ(Run("map " + drive.string() + " -o " + chain.string() + " --loops off").exit_code, 0);
+  // The looped run reuses the chain run's pair files and registers only its
+  // loops, as a user's second run would.
+  const fs::path looped = dir_ / "looped";
+  const RunResult chain = Run("map " + drive.string() + " -o " + looped.string() + " --loops off");
+  ASSERT_EQ(chain.exit_code, 0) << chain.err;
+  const double without = ate(looped);
   const RunResult r = Run("map " + drive.string() + " -o " + looped.string() + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json summary = json::parse(r.out);
+  EXPECT_GE(summary["pairs_reused"].get<int>(), 99) << "every chain pair";
   EXPECT_GT(summary["loops_closed"].get<int>(), 3);
   EXPECT_LE(summary["loops_closed"].get<int>(), summary["loop_candidates"].get<int>());
   EXPECT_THAT(r.err, ::testing::ContainsRegex("[0-9]+ loops closed of [0-9]+ candidates"));
@@ -615,7 +635,7 @@ TEST_F(MapCli, SevenScenesDriveClosesItsOwnLoops) {
     EXPECT_EQ(pair["in_graph"].get<bool>(), pair["left_out_because"].get<std::string>().empty());
   }
   EXPECT_EQ(loops, summary["loop_candidates"].get<int>());
-  const double without = ate(chain), with = ate(looped);
+  const double with = ate(looped);
   std::fprintf(stderr, "7-Scenes every 5th frame: ATE %.3f m without loops, %.3f m with\n", without,
                with);
   EXPECT_LT(with, 0.8 * without);
@@ -644,9 +664,10 @@ TEST_F(MapCli, AVlp16ReturnIsFoundByItsPlace) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return r.out;
   };
-  const fs::path chain = dir_ / "chain", looped = dir_ / "looped";
-  ASSERT_EQ(Run("map " + drive.string() + " -o " + chain.string() + " --loops off").exit_code, 0);
-  EXPECT_THAT(revisits(chain), HasSubstr("revisits: 0 of 2 within"));
+  // The looped run reuses the chain run's pairs.
+  const fs::path looped = dir_ / "looped";
+  ASSERT_EQ(Run("map " + drive.string() + " -o " + looped.string() + " --loops off").exit_code, 0);
+  EXPECT_THAT(revisits(looped), HasSubstr("revisits: 0 of 2 within"));
 
   const RunResult r = Run("map " + drive.string() + " -o " + looped.string() + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -658,6 +679,106 @@ TEST_F(MapCli, AVlp16ReturnIsFoundByItsPlace) {
     }
   }
   EXPECT_GE(closed_by_place, 1);
+}
+
+// Two drives of one street, in two folders, each scan in its own sensor
+// frame: each drive is chained, place recognition joins the second to the
+// first with no prior between them, and each drive's trajectory is written
+// in the first drive's frame.
+TEST_F(MapCli, TwoDrivesOfOneStreetMakeOneMap) {
+  const fs::path first = MakeDrive(8), second = SplitDrive(first, 4, "second");
+  const fs::path out = dir_ / "out";
+  const RunResult r = Run("map " + first.string() + " " + second.string() + " -o " + out.string() +
+                          Quick() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json summary = json::parse(r.out);
+  ASSERT_EQ(summary["drives"].size(), 2u);
+  EXPECT_EQ(summary["drives"][1]["first_scan"], 4);
+  EXPECT_EQ(summary["drives"][1]["scans"], 4);
+  EXPECT_EQ(summary["drives"][1]["trajectory_kitti"], "trajectory-second.kitti");
+  EXPECT_EQ(summary["outputs"]["trajectory-second.kitti"],
+            (out / "trajectory-second.kitti").string());
+
+  int joining = 0;
+  for (const json& pair : json::parse(Slurp(out / "pairs.json"))) {
+    const int source = pair["source"].get<int>(), target = pair["target"].get<int>();
+    EXPECT_FALSE(pair["kind"] == "chain" && (source < 4) != (target < 4))
+        << "no chain pair joins the drives";
+    if ((source < 4) != (target < 4) && pair["in_graph"].get<bool>()) {
+      ++joining;
+      EXPECT_EQ(pair["found_by"], "place");
+    }
+  }
+  EXPECT_GE(joining, 1);
+
+  const std::vector<Transform> drive_one =
+      ReadKittiTrajectory((out / "trajectory-drive.kitti").string());
+  const std::vector<Transform> drive_two =
+      ReadKittiTrajectory((out / "trajectory-second.kitti").string());
+  ASSERT_EQ(drive_one.size(), 4u);
+  ASSERT_EQ(drive_two.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const Transform truth = truth_[0].inverse() * truth_[4 + i];
+    EXPECT_LT(TranslationNorm(truth.inverse() * drive_two[i]), 0.1) << "second drive, scan " << i;
+    EXPECT_LT(RotationAngle(truth.inverse() * drive_two[i]), 0.02) << "second drive, scan " << i;
+  }
+}
+
+// A second drive of another street: no trusted pair joins it to the first,
+// and the map names it instead of placing it anywhere.
+TEST_F(MapCli, ADriveThatOverlapsNoOtherIsNamed) {
+  const fs::path first = MakeDrive(4), elsewhere = dir_ / "elsewhere";
+  fs::create_directories(elsewhere);
+  const Points other_street = MakeStreetSegment(29, 2);  // x from 120 to 200 m
+  for (int i = 0; i < 3; ++i) {
+    const Transform pose = PoseFromYawTranslation(1.2 + 0.04 * i, {155.0 + 2.0 * i, 0.5, 1.8});
+    char name[32];
+    std::snprintf(name, sizeof(name), "other%03d.xyz", i);
+    WriteXyz((elsewhere / name).string(), SimulateScan(other_street, pose, 30.0, 0.02, 300 + i));
+  }
+  const RunResult r = Run("map " + first.string() + " " + elsewhere.string() + " -o " +
+                          (dir_ / "out").string() + Quick());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("drive 2 (from " + (elsewhere / "other000.xyz").string() +
+                               "): overlaps no other drive"));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "trajectory.kitti"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "pairs" / "000004-000005.json"))
+      << "pairs kept for a rerun";
+  int registered = 0;
+  for (const auto& file : fs::directory_iterator(dir_ / "out" / "pairs"))
+    registered += file.is_regular_file();
+  EXPECT_GT(registered, 5) << "besides the 5 chain pairs, a place candidate joining the drives";
+
+  const RunResult single = Run("map " + first.string() + " " + (dir_ / "none").string() + " -o " +
+                               (dir_ / "out2").string() + Quick());
+  EXPECT_EQ(single.exit_code, 2);
+  EXPECT_THAT(single.err, HasSubstr((dir_ / "none").string()));
+}
+
+// The same return as two drives in two folders (scans 9-21; 385-386): no
+// chain pair joins them, place recognition does, and the revisits across
+// them agree with revisits.csv.
+TEST_F(MapCli, TwoVlp16DrivesJoinWhereTheyRevisit) {
+  const fs::path data = fs::path(BOICP_SHARED_DATA_DIR) / "vlp16_loop";
+  if (!fs::is_directory(data)) GTEST_SKIP() << "shared data not found at " << data;
+  const fs::path first = dir_ / "first", second = dir_ / "second";
+  fs::create_directories(first);
+  fs::create_directories(second);
+  for (int frame = 9; frame <= 21; ++frame) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.pcd", frame);
+    fs::create_symlink(data / "pcd" / name, first / name);
+  }
+  for (const char* name : {"000385.pcd", "000386.pcd"}) {
+    fs::create_symlink(data / "pcd" / name, second / name);
+  }
+  const fs::path out = dir_ / "out";
+  const RunResult r = Run("map " + first.string() + " " + second.string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const RunResult scored =
+      Run("eval " + out.string() + " --reference " + (data / "revisits.csv").string());
+  EXPECT_THAT(scored.out, HasSubstr("revisits: 2 of 2 within 0.3 m and 2 deg"));
+  EXPECT_EQ(ReadKittiTrajectory((out / "trajectory-second.kitti").string()).size(), 2u);
 }
 
 // Two real VLP-16 scans 3 m apart (000099, 000100 of ../shared/data/vlp16_loop):
@@ -747,11 +868,11 @@ TEST_F(MapCli, ADoubtfulScanIsBridgedNamedAndLeftOut) {
         << "scan " << i;
   }
 
-  // Placed, the noise adds its cells to the map.
-  const fs::path placed = dir_ / "placed";
-  const RunResult p = Run("map " + scans.string() + " -o " + placed.string() + Quick() +
+  // Placed, the noise adds its cells to the map; the pairs are the same.
+  const RunResult p = Run("map " + scans.string() + " -o " + out.string() + Quick() +
                           " --untrusted-scans place --json");
   ASSERT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_EQ(json::parse(p.out)["pairs_reused"], 9) << "5 chain pairs and 4 bridges";
   EXPECT_THAT(p.err, HasSubstr("1 scan has no trusted pair; placed by the best doubtful pair: "
                                "scan003.xyz"));
   EXPECT_GT(json::parse(p.out)["occupied_leaves"].get<int>(),
@@ -905,6 +1026,41 @@ TEST_F(MapCli, SameTrajectoryAsTheDaemonForEveryPairing) {
       }
     }
   }
+}
+
+// The daemon maps two drives as `boicp map` does: `submit A B` sends them as
+// one batch with its drive start, and `export --drive 2` gives the second
+// drive's trajectory as map's trajectory-NAME file.
+TEST_F(MapCli, TwoDrivesGiveTheDaemonTheMapsTrajectories) {
+  const fs::path first = MakeDrive(8), second = SplitDrive(first, 4, "second");
+  const fs::path out = dir_ / "out";
+  const std::string drives = " " + first.string() + " " + second.string() + Quick();
+  ASSERT_EQ(Run("map" + drives + " -o " + out.string()).exit_code, 0);
+
+  test::DaemonProcess daemon({"--data-dir", (dir_ / "daemon").string(), "--workers", "2"},
+                             (dir_ / "daemon.log").string());
+  const std::string server = " --server " + daemon.address();
+  const RunResult submitted = Run("submit" + drives + " --wait" + server);
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.err << daemon.Log();
+  const std::string job = submitted.out.substr(0, submitted.out.find('\n'));
+  const RunResult shown = Run("show " + job + " --json" + server);
+  EXPECT_EQ(json::parse(shown.out)["drives"], 2);
+
+  const fs::path exported = dir_ / "second.kitti";
+  const RunResult r =
+      Run("export " + job + " --format kitti --drive 2 -o " + exported.string() + server);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<Transform> remote = ReadKittiTrajectory(exported.string());
+  const std::vector<Transform> local =
+      ReadKittiTrajectory((out / "trajectory-second.kitti").string());
+  ASSERT_EQ(remote.size(), 4u);
+  ASSERT_EQ(local.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) EXPECT_TRUE(remote[i].isApprox(local[i], 1e-9)) << "scan " << i;
+
+  const RunResult third = Run("export " + job + " --format kitti --drive 3" + server);
+  EXPECT_EQ(third.exit_code, 2) << third.err;
+  EXPECT_THAT(third.err, HasSubstr("has 2 drives, not 3"));
+  EXPECT_EQ(Run("export " + job + " --format bt --drive 1" + server).exit_code, 2);
 }
 #endif
 

@@ -173,5 +173,22 @@ TEST_F(MapOutputs, EstimatePosesAnchorsOnTheFirstPrior) {
   EXPECT_TRUE(estimate.poses[1].isApprox(*scans[0].prior_pose * T10.inverse()));
 }
 
+// Two drives that nothing joins: each in its own first scan's frame. A
+// scan its own drive does not reach is still an error.
+TEST_F(MapOutputs, EstimatePosesPlacesEachDriveApartInItsOwnFrame) {
+  std::vector<ScanSource> scans(4);
+  const Transform T10 = PoseFromYawTranslation(0.1, {-1, 0, 0});
+  const Transform T32 = PoseFromYawTranslation(-0.2, {0, 2, 0});
+  const PoseEstimate estimate = EstimatePoses(scans, {{{0, 1}, T10}, {{3, 2}, T32}}, {}, {2});
+  ASSERT_EQ(estimate.poses.size(), 4u);
+  EXPECT_TRUE(estimate.poses[1].isApprox(T10.inverse()));
+  EXPECT_TRUE(estimate.poses[2].isApprox(Transform::Identity()));
+  EXPECT_TRUE(estimate.poses[3].isApprox(T32));
+  EXPECT_EQ(estimate.kept, std::vector<bool>({true, true}));
+
+  EXPECT_THROW(EstimatePoses(scans, {{{0, 1}, T10}, {{3, 2}, T32}}, {}), InputError) << "one drive";
+  EXPECT_THROW(EstimatePoses(scans, {{{0, 1}, T10}}, {}, {2}), InputError) << "scan 3 unreached";
+}
+
 }  // namespace
 }  // namespace boicp

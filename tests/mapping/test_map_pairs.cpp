@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "boicp/mapping/batch_pairing.hpp"
+#include "boicp/mapping/drives.hpp"
 #include "boicp/mapping/map_pairs.hpp"
 #include "boicp/mapping/map_up.hpp"
 #include "boicp/util/types.hpp"
@@ -203,6 +204,52 @@ TEST(KeyframePlanner, RejectsBadArguments) {
   EXPECT_THROW(KeyframePlanner(0, 0.7), InputError);
   EXPECT_THROW(KeyframePlanner(3, 0.0), InputError);
   EXPECT_THROW(KeyframePlanner(3, 1.5), InputError);
+}
+
+TEST(Drives, EachScanBelongsToTheDriveThatStartsAtOrBeforeIt) {
+  EXPECT_EQ(DriveOf({}, 7), 0);
+  EXPECT_EQ(DriveOf({3, 5}, 2), 0);
+  EXPECT_EQ(DriveOf({3, 5}, 3), 1);
+  EXPECT_EQ(DriveOf({3, 5}, 6), 2);
+}
+
+TEST(Drives, ConsecutivePairsStayWithinADrive) {
+  const std::vector<PairIndex> pairs = ConsecutivePairsOfDrives(6, {3});
+  ASSERT_EQ(pairs.size(), 4u);
+  EXPECT_EQ(pairs[1], (PairIndex{1, 2}));
+  EXPECT_EQ(pairs[2], (PairIndex{3, 4}));
+  EXPECT_EQ(ConsecutivePairsOfDrives(6, {}), ConsecutivePairs(6));
+}
+
+TEST(Drives, ADriveOfOneScanIsNamed) {
+  EXPECT_NO_THROW(ValidateDriveStarts(6, {2, 4}));
+  try {
+    ValidateDriveStarts(5, {2, 4}, {"a", "b", "c"});
+    FAIL() << "drive c has one scan";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("c: a drive needs at least 2 scans, it has 1"));
+  }
+  EXPECT_THROW(ValidateDriveStarts(6, {3, 2}), InputError) << "not ascending";
+}
+
+TEST(Drives, DrivesApartFromTheFirstAreListed) {
+  const std::vector<PairIndex> chains = ConsecutivePairsOfDrives(9, {3, 6});
+  EXPECT_EQ(DrivesApartFromTheFirst(9, {3, 6}, chains), std::vector<int>({1, 2}));
+  std::vector<PairIndex> joined = chains;
+  joined.push_back({7, 4});  // the third drive joins the second, not the first
+  EXPECT_EQ(DrivesApartFromTheFirst(9, {3, 6}, joined), std::vector<int>({1, 2}));
+  joined.push_back({5, 0});
+  EXPECT_EQ(DrivesApartFromTheFirst(9, {3, 6}, joined), std::vector<int>());
+}
+
+TEST(Drives, SeveralDrivesArePlannedAsChainsOfConsecutivePairs) {
+  std::vector<ScanSource> scans(5);
+  PairingRequest request;
+  request.drive_starts = {2};
+  const PairingPlan plan = PlanPairing(request, scans, std::nullopt);
+  EXPECT_EQ(plan.chain, std::vector<PairIndex>({{0, 1}, {2, 3}, {3, 4}}));
+  request.mode = PairingMode::kOverlap;
+  EXPECT_THROW(PlanPairing(request, scans, std::nullopt), InputError);
 }
 
 }  // namespace

@@ -154,6 +154,37 @@ TEST_F(PlaceCandidatesOnALoop, FindsReturnsAtTheirHeading) {
   }
 }
 
+// The return as a second drive (scans 20-29): each drive has its own
+// budget, pairs joining the drives are taken first, and the sequence gap
+// holds within a drive only (scan 20 returns to scan 9, 11 scans back).
+TEST_F(PlaceCandidatesOnALoop, ASecondDriveIsJoinedWhereItReturns) {
+  LoopCandidateOptions options;
+  options.min_sequence_gap = 15;
+  options.min_spacing = 1;
+  options.max_place_per_drive_scan = 0.1;
+  std::vector<int> pieces(kScans, 0);
+  for (int i = 20; i < kScans; ++i) pieces[static_cast<size_t>(i)] = 20;
+  const std::vector<LoopCandidate> found =
+      LoopCandidatesFromPlaces(*places_, Origins(), pieces, {}, options, {20});
+  ASSERT_EQ(found.size(), 3u) << "the budgets: a tenth of 20 scans and of 10";
+  for (const LoopCandidate& c : found) {
+    EXPECT_GE(c.pair.source, 20);
+    EXPECT_LT(c.pair.target, 20);
+    const Transform truth = Pose(c.pair.target).inverse() * Pose(c.pair.source);
+    EXPECT_LT((truth.topRightCorner<3, 1>().norm()), 2.0) << PairName(c.pair);
+  }
+
+  options.max_place_per_drive_scan = 1.0;
+  const auto closest = [](const std::vector<LoopCandidate>& candidates) {
+    int gap = 1000;
+    for (const LoopCandidate& c : candidates) gap = std::min(gap, c.pair.source - c.pair.target);
+    return gap;
+  };
+  EXPECT_LT(closest(LoopCandidatesFromPlaces(*places_, Origins(), pieces, {}, options, {20})), 15);
+  EXPECT_GE(closest(LoopCandidatesFromPlaces(*places_, Origins(), pieces, {}, options)), 15)
+      << "one drive";
+}
+
 TEST_F(PlaceCandidatesOnALoop, StaysClearOfPairsAlreadyTaken) {
   LoopCandidateOptions options;
   options.max_place_per_drive_scan = 1.0;

@@ -269,6 +269,19 @@ def test_an_exception_in_progress_stops_the_map_and_is_raised(drive, tmp_path):
     assert list((tmp_path / "pairs").glob("*.json"))
 
 
+def test_build_map_takes_several_drives(drive, tmp_path):
+    first, second = tmp_path / "first", tmp_path / "second"
+    first.mkdir()
+    second.mkdir()
+    scans = sorted(p for p in drive.iterdir() if p.suffix == ".xyz")
+    for k, scan in enumerate(scans):
+        (first if k < 3 else second).joinpath(scan.name).symlink_to(scan)
+    summary = boicp.build_map(first, tmp_path / "out", threads=1, more_paths=[str(second)],
+                              **QUICK)
+    assert [d["scans"] for d in summary["drives"]] == [3, 2]
+    assert (tmp_path / "out" / "trajectory-second.kitti").read_text().count("\n") == 2
+
+
 def test_build_map_names_a_bad_setting(drive, tmp_path):
     with pytest.raises(ValueError, match="unknown setting 'resolutoin'"):
         boicp.build_map(drive, tmp_path, resolutoin=0.2)

@@ -13,7 +13,7 @@ namespace {
 
 // More offsets than this either way cost more than the rest of the answer's
 // scoring; beyond it the slide steps by more than an inlier distance.
-constexpr int kMaxOffsetsEachWay = 48;
+constexpr int kMaxOffsetsEachWay = 32;
 
 // The 90th percentile of the moved source's distance from its mean along
 // `axis`: how far it can slide before it leaves its own footprint.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "boicp/mapping/drives.hpp"
+
 namespace boicp {
 namespace {
 
@@ -47,12 +49,20 @@ double BatchOverlapThreshold(const std::vector<ScanSource>& scans,
 PairingPlan PlanPairing(const PairingRequest& request, const std::vector<ScanSource>& scans,
                         const std::optional<SensorKind>& sensor, const std::string& pairs_source) {
   const int n = static_cast<int>(scans.size());
+  if (!request.drive_starts.empty()) {
+    if (request.mode != PairingMode::kConsecutive) {
+      throw InputError("several drives: each is chained by consecutive pairing, not " +
+                       PairingModeName(request.mode));
+    }
+    ValidateDriveStarts(n, request.drive_starts);
+  }
   switch (request.mode) {
     case PairingMode::kConsecutive: {
-      std::vector<PairIndex> all = ConsecutivePairs(n);
+      const std::vector<PairIndex> chain = ConsecutivePairsOfDrives(n, request.drive_starts);
+      std::vector<PairIndex> all = chain;
       all.insert(all.end(), request.pairs.begin(), request.pairs.end());
-      ValidateListedPairs(n, all, /*require_connected=*/true, pairs_source);
-      return PlanFixedPairs(ConsecutivePairs(n), request.pairs);
+      ValidateListedPairs(n, all, /*require_connected=*/request.drive_starts.empty(), pairs_source);
+      return PlanFixedPairs(chain, request.pairs);
     }
     case PairingMode::kOverlap: {
       const double threshold = request.overlap_threshold;

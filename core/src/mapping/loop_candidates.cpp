@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "boicp/mapping/drives.hpp"
+
 namespace boicp {
 namespace {
 
@@ -52,10 +54,15 @@ std::vector<LoopCandidate> PairsWithinReach(const std::vector<Transform>& poses,
   return within;
 }
 
-bool NearAny(const PairIndex& pair, const std::vector<PairIndex>& others, int spacing) {
-  return std::any_of(others.begin(), others.end(), [&](const PairIndex& k) {
-    return std::abs(k.source - pair.source) < spacing && std::abs(k.target - pair.target) < spacing;
-  });
+// Whether `a` and `b` lie within `spacing` scans of each other at both
+// ends, each end in one drive: scans of two drives are no neighbours,
+// whatever their indices.
+bool Near(const PairIndex& a, const PairIndex& b, int spacing,
+          const std::vector<int>& drive_starts) {
+  const auto near = [&](int i, int j) {
+    return std::abs(i - j) < spacing && DriveOf(drive_starts, i) == DriveOf(drive_starts, j);
+  };
+  return near(a.source, b.source) && near(a.target, b.target);
 }
 
 // `budget_per_scan` times the drive's scans, at least one.
@@ -69,13 +76,18 @@ size_t DriveBudget(double budget_per_scan, size_t num_scans) {
 // by pair.
 std::vector<LoopCandidate> TakeBest(const std::vector<LoopCandidate>& ranked, size_t budget,
                                     std::vector<PairIndex> near,
-                                    const LoopCandidateOptions& options) {
+                                    const LoopCandidateOptions& options,
+                                    const std::vector<int>& drive_starts = {}) {
   std::vector<LoopCandidate> kept;
   std::map<int, int> per_scan;
   for (const LoopCandidate& c : ranked) {
     if (kept.size() >= budget) break;
     if (per_scan[c.pair.source] >= options.max_per_scan) continue;
-    if (NearAny(c.pair, near, options.min_spacing)) continue;
+    if (std::any_of(near.begin(), near.end(), [&](const PairIndex& k) {
+          return Near(c.pair, k, options.min_spacing, drive_starts);
+        })) {
+      continue;
+    }
     ++per_scan[c.pair.source];
     kept.push_back(c);
     near.push_back(c.pair);
@@ -85,17 +97,22 @@ std::vector<LoopCandidate> TakeBest(const std::vector<LoopCandidate>& ranked, si
   return kept;
 }
 
-// The earlier scans (at least min_sequence_gap before `later`, described,
-// of another piece) whose ring keys are nearest `later`'s, at most
-// options.place_shortlist of them.
+// The earlier scans (of an earlier drive, or at least min_sequence_gap
+// before `later`; described, of another piece) whose ring keys are nearest
+// `later`'s, at most options.place_shortlist of them.
 std::vector<int> RingKeyShortlist(const std::vector<PlaceDescriptor>& places,
                                   const std::vector<int>& pieces, int later,
+                                  const std::vector<int>& drive_starts,
                                   const LoopCandidateOptions& options) {
   std::vector<std::pair<float, int>> by_key;
   const auto j = static_cast<size_t>(later);
-  for (int earlier = 0; earlier + options.min_sequence_gap <= later; ++earlier) {
+  const int drive = DriveOf(drive_starts, later);
+  for (int earlier = 0; earlier < later; ++earlier) {
     const auto i = static_cast<size_t>(earlier);
     if (places[i].empty() || pieces[i] == pieces[j]) continue;
+    if (earlier + options.min_sequence_gap > later && DriveOf(drive_starts, earlier) == drive) {
+      continue;
+    }
     by_key.emplace_back((places[i].ring_key - places[j].ring_key).squaredNorm(), earlier);
   }
   const auto count = std::min(by_key.size(), static_cast<size_t>(options.place_shortlist));
@@ -136,17 +153,18 @@ std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescr
                                                     const std::vector<Point>& sensor_origins,
                                                     const std::vector<int>& pieces,
                                                     const std::vector<PairIndex>& taken,
-                                                    const LoopCandidateOptions& options) {
+                                                    const LoopCandidateOptions& options,
+                                                    const std::vector<int>& drive_starts) {
   if (sensor_origins.size() != places.size() || pieces.size() != places.size()) {
     throw std::invalid_argument("loop candidates: one sensor origin and piece per descriptor");
   }
   std::vector<LoopCandidate> best_per_scan;
   const int n = static_cast<int>(places.size());
-  for (int later = options.min_sequence_gap; later < n; ++later) {
+  for (int later = 1; later < n; ++later) {
     const PlaceDescriptor& place = places[static_cast<size_t>(later)];
     if (place.empty()) continue;
     LoopCandidate best;
-    for (const int earlier : RingKeyShortlist(places, pieces, later, options)) {
+    for (const int earlier : RingKeyShortlist(places, pieces, later, drive_starts, options)) {
       const auto i = static_cast<size_t>(earlier), j = static_cast<size_t>(later);
       const PlaceMatch match = MatchPlaces(place, places[i]);
       if (match.distance >= best.place_distance) continue;
@@ -157,12 +175,22 @@ std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescr
     }
     if (best.found_by == LoopFoundBy::kPlace) best_per_scan.push_back(best);
   }
+  // Pairs that join two drives first: without them the drives make no map.
+  const auto joins_drives = [&drive_starts](const LoopCandidate& c) {
+    return DriveOf(drive_starts, c.pair.source) != DriveOf(drive_starts, c.pair.target);
+  };
   std::stable_sort(best_per_scan.begin(), best_per_scan.end(),
-                   [](const LoopCandidate& a, const LoopCandidate& b) {
+                   [&joins_drives](const LoopCandidate& a, const LoopCandidate& b) {
+                     if (joins_drives(a) != joins_drives(b)) return joins_drives(a);
                      return a.place_distance < b.place_distance;
                    });
-  return TakeBest(best_per_scan, DriveBudget(options.max_place_per_drive_scan, places.size()),
-                  taken, options);
+  size_t budget = 0;
+  for (size_t d = 0; d <= drive_starts.size(); ++d) {
+    const int first = d == 0 ? 0 : drive_starts[d - 1];
+    const int end = d < drive_starts.size() ? drive_starts[d] : n;
+    budget += DriveBudget(options.max_place_per_drive_scan, static_cast<size_t>(end - first));
+  }
+  return TakeBest(best_per_scan, budget, taken, options, drive_starts);
 }
 
 }  // namespace boicp

@@ -1,12 +1,15 @@
 #include "boicp/mapping/map_assembly.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <utility>
 
 #include "boicp/icp/voxel_cloud.hpp"
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/mapping/drives.hpp"
 #include "boicp/util/atomic_file.hpp"
 #include "boicp/util/parallel_for.hpp"
 
@@ -75,11 +78,11 @@ void WriteText(const std::string& path, const std::function<void(std::ostream&)>
   });
 }
 
-}  // namespace
-
-PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
-                           const std::vector<PairConstraint>& constraints,
-                           const PoseGraphOptions& options) {
+// The poses of scans that `constraints` connect (every scan reached from
+// scan 0).
+PoseEstimate EstimateConnectedPoses(const std::vector<ScanSource>& scans,
+                                    const std::vector<PairConstraint>& constraints,
+                                    const PoseGraphOptions& options) {
   const Transform anchor =
       !scans.empty() && scans[0].prior_pose ? *scans[0].prior_pose : Transform::Identity();
   const ChainedPoses chained = ChainPoses(static_cast<int>(scans.size()), constraints, anchor);
@@ -100,6 +103,61 @@ PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
   return estimate;
 }
 
+}  // namespace
+
+PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
+                           const std::vector<PairConstraint>& constraints,
+                           const PoseGraphOptions& options, const std::vector<int>& drive_starts) {
+  const int num_scans = static_cast<int>(scans.size());
+  if (drive_starts.empty()) return EstimateConnectedPoses(scans, constraints, options);
+  std::vector<PairIndex> pairs;
+  for (const PairConstraint& c : constraints) pairs.push_back(c.pair);
+  const std::vector<int> part_of_scan = ConnectedParts(num_scans, pairs);
+  std::map<int, std::vector<int>> parts;  // by their first scan
+  for (int i = 0; i < num_scans; ++i) parts[part_of_scan[static_cast<size_t>(i)]].push_back(i);
+  if (parts.size() == 1) return EstimateConnectedPoses(scans, constraints, options);
+
+  // Each part on its own, in its first scan's frame: scans renumbered
+  // within the part, and its constraints with them.
+  PoseEstimate estimate;
+  estimate.poses.assign(scans.size(), Transform::Identity());
+  estimate.kept.assign(constraints.size(), false);
+  estimate.left_out_because.assign(constraints.size(), "");
+  for (const auto& [first, part] : parts) {
+    if (first != 0 && DriveOf(drive_starts, first) == DriveOf(drive_starts, first - 1)) {
+      throw InputError("pose chain: no chain of registered pairs reaches scan " +
+                       std::to_string(first) + " from its drive's first scan");
+    }
+    std::vector<int> local(scans.size(), -1);
+    std::vector<ScanSource> part_scans;
+    for (const int i : part) {
+      local[static_cast<size_t>(i)] = static_cast<int>(part_scans.size());
+      part_scans.push_back(scans[static_cast<size_t>(i)]);
+    }
+    std::vector<PairConstraint> part_constraints;
+    std::vector<size_t> index_of;
+    for (size_t e = 0; e < constraints.size(); ++e) {
+      if (local[static_cast<size_t>(constraints[e].pair.source)] < 0) continue;
+      PairConstraint c = constraints[e];
+      c.pair = {local[static_cast<size_t>(c.pair.source)],
+                local[static_cast<size_t>(c.pair.target)]};
+      part_constraints.push_back(std::move(c));
+      index_of.push_back(e);
+    }
+    PoseEstimate part_estimate = EstimateConnectedPoses(part_scans, part_constraints, options);
+    for (size_t k = 0; k < part.size(); ++k) {
+      estimate.poses[static_cast<size_t>(part[k])] = part_estimate.poses[k];
+    }
+    for (size_t k = 0; k < index_of.size(); ++k) {
+      estimate.kept[index_of[k]] = part_estimate.kept[k];
+      estimate.left_out_because[index_of[k]] = std::move(part_estimate.left_out_because[k]);
+    }
+    estimate.loop_closures += part_estimate.loop_closures;
+    estimate.optimised = estimate.optimised || part_estimate.optimised;
+  }
+  return estimate;
+}
+
 void WriteTrajectories(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
                        const MapOutputPaths& outputs) {
   if (!outputs.trajectory_tum.empty()) {
@@ -109,6 +167,22 @@ void WriteTrajectories(const std::vector<ScanSource>& scans, const std::vector<T
   if (!outputs.trajectory_kitti.empty()) {
     WriteText(outputs.trajectory_kitti,
               [&](std::ostream& out) { WriteKittiTrajectory(out, poses); });
+  }
+}
+
+void WriteDriveTrajectories(const std::vector<ScanSource>& scans,
+                            const std::vector<Transform>& poses,
+                            const std::vector<int>& drive_starts,
+                            const std::vector<std::string>& stems) {
+  for (size_t d = 0; d < stems.size(); ++d) {
+    const auto from = static_cast<std::ptrdiff_t>(d == 0 ? 0 : drive_starts[d - 1]);
+    const auto to = static_cast<std::ptrdiff_t>(
+        d < drive_starts.size() ? drive_starts[d] : static_cast<int>(scans.size()));
+    MapOutputPaths paths;
+    paths.trajectory_tum = stems[d] + ".tum";
+    paths.trajectory_kitti = stems[d] + ".kitti";
+    WriteTrajectories({scans.begin() + from, scans.begin() + to},
+                      {poses.begin() + from, poses.begin() + to}, paths);
   }
 }
 

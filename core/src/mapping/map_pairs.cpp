@@ -38,6 +38,21 @@ std::vector<PairIndex> ConsecutivePairs(int num_scans) {
   return pairs;
 }
 
+std::vector<int> ConnectedParts(int num_scans, const std::vector<PairIndex>& pairs) {
+  std::vector<int> part(static_cast<size_t>(std::max(num_scans, 0)));
+  std::iota(part.begin(), part.end(), 0);
+  const auto root = [&part](int i) {
+    while (part[static_cast<size_t>(i)] != i) i = part[static_cast<size_t>(i)];
+    return i;
+  };
+  for (const PairIndex& p : pairs) {
+    const int a = root(p.source), b = root(p.target);
+    part[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  }
+  for (int i = 0; i < num_scans; ++i) part[static_cast<size_t>(i)] = root(i);
+  return part;
+}
+
 void ValidatePairs(int num_scans, const std::vector<PairIndex>& pairs, bool require_connected) {
   std::set<std::pair<int, int>> seen;
   std::vector<int> parent(static_cast<size_t>(std::max(num_scans, 0)));

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/drives.hpp"
 #include "boicp/mapping/loop_candidates.hpp"
 
 namespace boicp {
@@ -33,9 +34,11 @@ struct BridgeOffset {
 constexpr BridgeOffset kBridgeOffsets[] = {
     {0, 0, true}, {1, 0, false}, {0, 1, false}, {1, 1, false}};
 
-// The bridge `offset` puts over the chain pair `link`, if not registered yet.
+// The bridge `offset` puts over the chain pair `link`, if not registered yet
+// and within the link's drive.
 std::optional<PairIndex> BridgeOver(const PairIndex& link, const BridgeOffset& offset,
-                                    int num_scans, const RegisteredPairs& registered,
+                                    int num_scans, const std::vector<int>& drive_starts,
+                                    const RegisteredPairs& registered,
                                     std::set<std::pair<int, int>>& registered_already) {
   if (offset.reversed) {
     const PairIndex reversed{link.target, link.source};
@@ -45,6 +48,8 @@ std::optional<PairIndex> BridgeOver(const PairIndex& link, const BridgeOffset& o
   const auto [low, high] = Unordered(link);
   const PairIndex bridge{low - offset.back, high + offset.on};
   if (bridge.source < 0 || bridge.target >= num_scans ||
+      DriveOf(drive_starts, bridge.source) != DriveOf(drive_starts, low) ||
+      DriveOf(drive_starts, bridge.target) != DriveOf(drive_starts, high) ||
       !registered_already.insert(Unordered(bridge)).second) {
     return std::nullopt;
   }
@@ -69,13 +74,19 @@ PlaceGrid BatchPlaceGrid(const std::vector<ScanSource>& scans) {
 }
 
 // A later stage's progress: only the pairs it registers are new, and they
-// are counted on from the `before` pairs reported by the stages before it.
+// are counted on from the pairs the stages before it finished. Its plan
+// holds those again, so of the pairs it loads from the store only the ones
+// they do not hold were reused by this stage.
 class StageProgress : public MapProgressSink {
  public:
-  StageProgress(MapProgressSink& inner, int before) : inner_(inner), before_(before) {}
+  StageProgress(MapProgressSink& inner, const RegisteredPairs& before)
+      : inner_(inner), before_(static_cast<int>(before.finished.size())) {
+    for (const auto& entry : before.finished) finished_before_.insert(entry.first);
+  }
   void PairFinished(const PairResult& pair, bool reused, const PairCounts& counts) override {
     if (reused) {
       ++reused_;
+      if (finished_before_.count(pair.pair) == 0) ++reused_new_;
       return;
     }
     PairCounts continued = counts;
@@ -87,11 +98,14 @@ class StageProgress : public MapProgressSink {
     inner_.PairFailed(pair, message);
   }
   void Heartbeat() override { inner_.Heartbeat(); }
+  int ReusedNew() const { return reused_new_; }
 
  private:
   MapProgressSink& inner_;
   int before_ = 0;
+  std::set<PairIndex> finished_before_;
   int reused_ = 0;
+  int reused_new_ = 0;
 };
 
 bool IsTrusted(const PairResult& result) { return result.confidence >= kTrustedFrom; }
@@ -99,19 +113,11 @@ bool IsTrusted(const PairResult& result) { return result.confidence >= kTrustedF
 // Each scan's piece: scans that trusted pairs connect, however indirectly,
 // share one label (the smallest index among them).
 std::vector<int> TrustedPieces(int num_scans, const RegisteredPairs& registered) {
-  std::vector<int> piece(static_cast<size_t>(num_scans));
-  for (int i = 0; i < num_scans; ++i) piece[static_cast<size_t>(i)] = i;
-  const auto root = [&piece](int i) {
-    while (piece[static_cast<size_t>(i)] != i) i = piece[static_cast<size_t>(i)];
-    return i;
-  };
+  std::vector<PairIndex> trusted;
   for (const auto& [pair, result] : registered.finished) {
-    if (!IsTrusted(result)) continue;
-    const int a = root(pair.source), b = root(pair.target);
-    piece[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+    if (IsTrusted(result)) trusted.push_back(pair);
   }
-  for (int i = 0; i < num_scans; ++i) piece[static_cast<size_t>(i)] = root(i);
-  return piece;
+  return ConnectedParts(num_scans, trusted);
 }
 
 // Why each edge the poses do not use, and each bridge or loop candidate
@@ -133,6 +139,24 @@ std::map<PairIndex, std::string> LeftOut(const GraphEdges& edges, const Register
     if (!estimate.kept.at(i)) left_out[edges.pairs[i]] = estimate.left_out_because.at(i);
   }
   return left_out;
+}
+
+// Throws InputError naming each drive that the pairs in the graph join to
+// no other: several drives make one map only where they overlap.
+void RequireDrivesJoined(const MapBatch& batch, const std::vector<PairIndex>& in_graph) {
+  const std::vector<int>& starts = batch.pairing.drive_starts;
+  const std::vector<int> apart =
+      DrivesApartFromTheFirst(static_cast<int>(batch.scans.size()), starts, in_graph);
+  if (apart.empty()) return;
+  std::string named;
+  for (const int drive : apart) {
+    const int first = starts[static_cast<size_t>(drive - 1)];
+    named += (named.empty() ? "" : "; ") + std::string("drive ") + std::to_string(drive + 1) +
+             " (from " + batch.scans[static_cast<size_t>(first)].path + ")";
+  }
+  throw InputError(named + (apart.size() == 1 ? ": overlaps" : ": overlap") +
+                   " no other drive; no trusted pair joins " + (apart.size() == 1 ? "it" : "them") +
+                   " to the first drive's map (its pairs are kept for a rerun)");
 }
 
 }  // namespace
@@ -196,12 +220,12 @@ void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairSto
     if (open.empty()) return;
     const PoseEstimate chained =
         EstimatePoses(batch.scans, GraphConstraints(batch.plan, registered).constraints,
-                      BatchPoseGraphOptions(batch.config));
+                      BatchPoseGraphOptions(batch.config), batch.pairing.drive_starts);
     PairingPlan plan = PlanFixedPairs(registered.chain, batch.plan.extras);
     std::vector<PairIndex> bridges;
     for (const PairIndex& link : open) {
-      const std::optional<PairIndex> over =
-          BridgeOver(link, offset, num_scans, registered, registered_already);
+      const std::optional<PairIndex> over = BridgeOver(
+          link, offset, num_scans, batch.pairing.drive_starts, registered, registered_already);
       if (!over) continue;
       const PairIndex bridge = *over;
       plan.extras.push_back(bridge);
@@ -211,9 +235,10 @@ void RegisterBridges(const MapBatch& batch, RegisteredPairs& registered, PairSto
       bridges.push_back(bridge);
     }
     if (bridges.empty()) continue;
-    StageProgress bridge_progress(progress, static_cast<int>(registered.finished.size()));
+    StageProgress bridge_progress(progress, registered);
     RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan,
                                                  store, bridge_progress, execution);
+    registered.reused += bridge_progress.ReusedNew();
     for (const PairIndex& p : bridges) {
       registered.finished[p] = std::move(found.finished.at(p));
       registered.bridges.push_back(p);
@@ -248,7 +273,7 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
                             MapProgressSink& progress, const PairExecution& execution) {
   const PoseEstimate chained =
       EstimatePoses(batch.scans, GraphConstraints(batch.plan, registered).constraints,
-                    BatchPoseGraphOptions(batch.config));
+                    BatchPoseGraphOptions(batch.config), batch.pairing.drive_starts);
   LoopCandidateOptions options;
   options.reach = batch.config.translation_bounds.maxCoeff();
   std::set<std::pair<int, int>> registered_already;
@@ -264,8 +289,10 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
     loops.push_back(c.pair);
   };
   const ScanViews views = ViewScans(batch.scans, chained.poses);
+  // Drives not joined yet have poses in frames of their own.
+  const std::vector<int>& drive_starts = batch.pairing.drive_starts;
   for (const LoopCandidate& c : LoopCandidatesFromPoses(chained.poses, views.centres, options)) {
-    propose(c);
+    if (DriveOf(drive_starts, c.pair.source) == DriveOf(drive_starts, c.pair.target)) propose(c);
   }
   // Place recognition joins only scans no trusted pair connects yet; pairs
   // already registered or proposed are not proposed again, nor their
@@ -276,14 +303,15 @@ void RegisterLoopCandidates(const MapBatch& batch, RegisteredPairs& registered, 
     taken.push_back({later, earlier});
   }
   const std::vector<int> pieces = TrustedPieces(static_cast<int>(batch.scans.size()), registered);
-  for (const LoopCandidate& c :
-       LoopCandidatesFromPlaces(views.places, views.sensor_origins, pieces, taken, options)) {
+  for (const LoopCandidate& c : LoopCandidatesFromPlaces(views.places, views.sensor_origins, pieces,
+                                                         taken, options, drive_starts)) {
     propose(c);
   }
   if (loops.empty()) return;
-  StageProgress loop_progress(progress, static_cast<int>(registered.finished.size()));
+  StageProgress loop_progress(progress, registered);
   RegisteredPairs found = RegisterPlannedPairs(batch.scans, batch.config, batch.scale, plan, store,
                                                loop_progress, execution);
+  registered.reused += loop_progress.ReusedNew();
   for (const PairIndex& p : loops) registered.finished[p] = std::move(found.finished.at(p));
   registered.loops = std::move(loops);
 }
@@ -342,8 +370,10 @@ AssembledMap AssembleMap(const MapBatch& batch, const RegisteredPairs& registere
   progress.StageStarted(loops ? MapStage::kOptimising : MapStage::kChaining, 1);
   AssembledMap assembled;
   assembled.estimate =
-      EstimatePoses(batch.scans, edges.constraints, BatchPoseGraphOptions(batch.config));
+      EstimatePoses(batch.scans, edges.constraints, BatchPoseGraphOptions(batch.config),
+                    batch.pairing.drive_starts);
   assembled.in_graph = PairsInGraph(edges, assembled.estimate);
+  RequireDrivesJoined(batch, assembled.in_graph);
   assembled.left_out = LeftOut(edges, registered, assembled.estimate);
   store.MarkInGraph(assembled.in_graph, assembled.left_out);
   progress.PosesEstimated(assembled.estimate, assembled.in_graph);

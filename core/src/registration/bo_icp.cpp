@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "boicp/icp/preprocess.hpp"
 #include "boicp/icp/slide_rival.hpp"
 #include "boicp/icp/unconstrained_slides.hpp"
 #include "boicp/registration/auto_settings.hpp"
@@ -416,9 +417,9 @@ RegistrationResult RegisterScans(const ScanPyramid& source, const ScanPyramid& t
   const std::vector<FreeSlide> slides =
       PrincipalSlides(information, config.EffectiveInlierDistance());
   if (!slides.empty())
-    result.features.slide_rival =
-        SlideRivalShare(finest.source, finest.target, kept.refined.transform, slides.front().axis,
-                        config.EffectiveInlierDistance());
+    result.features.slide_rival = SlideRivalShare(
+        RandomSubsample(finest.source, kSlideRivalPoints, config.seed), finest.target,
+        kept.refined.transform, slides.front().axis, config.EffectiveInlierDistance());
   result.confidence = std::min(kept.confidence, Confidence(result.features));
   result.doubtful = result.confidence < kTrustedFrom;
   result.gp_mean = kept.gp_mean;

@@ -3,6 +3,8 @@
 // slide: on a street of look-alike facades, ground and facades fit as well
 // a block further on, and the answer's own spot is one of many.
 
+#include <cstddef>
+
 #include <Eigen/Core>
 
 #include "boicp/icp/nearest_neighbors.hpp"
@@ -18,6 +20,10 @@ constexpr double kRivalSlideStart = 4.0;
 /// slide: a dense scan's inlier distance is millimetres, and a slide of a
 /// few of them keeps most of any smooth surface's fit.
 constexpr double kRivalSlideShare = 0.05;
+
+/// Source points enough to measure a share to about 0.01 (binomial error of
+/// a fitness near 1/2); a finer level's more would only cost time.
+constexpr size_t kSlideRivalPoints = 2000;
 
 /// The highest fitness of `source` moved by T_target_source and then slid
 /// along the unit `axis` (target frame), either way, by kRivalSlideStart

@@ -34,6 +34,9 @@ struct PairingRequest {
   /// registered besides their own (loop closures), which the pose graph
   /// weighs against the chain.
   std::vector<PairIndex> pairs;
+  /// Several drives of one place (consecutive pairing only): the first scan
+  /// of each drive after the first, ascending (drives.hpp). Empty: one drive.
+  std::vector<int> drive_starts;
 };
 
 /// The keyframe overlap threshold of a batch: that of the `sensor` the user
@@ -44,10 +47,12 @@ double BatchOverlapThreshold(const std::vector<ScanSource>& scans,
 /// The plan of `request` for `scans` (at least 2) whose sensor the user set
 /// to `sensor` (nullopt: auto). Throws InputError for a pair outside the
 /// scans, a scan paired with itself or twice, pairs that leave a scan
-/// unreached (consecutive and explicit: the plan must connect every scan)
+/// unreached (consecutive and explicit: the plan must connect every scan of
+/// one drive; several drives are joined later, by the pairs the map finds)
 /// or explicit pairing without pairs, naming `pairs_source` (where the pairs
-/// came from: the API's field, or a file); and for a threshold outside
-/// (0, 1], naming "pairing.overlap_threshold".
+/// came from: the API's field, or a file); for a threshold outside (0, 1],
+/// naming "pairing.overlap_threshold"; and for drive starts with another
+/// mode than consecutive, or a drive of fewer than 2 scans.
 PairingPlan PlanPairing(const PairingRequest& request, const std::vector<ScanSource>& scans,
                         const std::optional<SensorKind>& sensor,
                         const std::string& pairs_source = "pairing.pairs");

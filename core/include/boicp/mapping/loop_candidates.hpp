@@ -99,12 +99,16 @@ std::vector<LoopCandidate> LoopCandidatesFromPoses(const std::vector<Transform>&
 /// most alike first under the per-scan cap, the spacing (also from every
 /// pair of `taken`, e.g. the candidates from poses) and the drive's place
 /// budget (at least one). No pair closer than min_sequence_gap along the
-/// sequence. Sorted by (source, target). Preconditions: one origin and one
-/// piece per descriptor; non-empty descriptors of one grid; options as above.
+/// sequence. Of several drives (`drive_starts`, drives.hpp), each has its
+/// own budget, the gap holds within a drive only, and pairs that join two
+/// drives are taken first. Sorted by (source, target). Preconditions: one
+/// origin and one piece per descriptor; non-empty descriptors of one grid;
+/// options as above.
 std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescriptor>& places,
                                                     const std::vector<Point>& sensor_origins,
                                                     const std::vector<int>& pieces,
                                                     const std::vector<PairIndex>& taken,
-                                                    const LoopCandidateOptions& options);
+                                                    const LoopCandidateOptions& options,
+                                                    const std::vector<int>& drive_starts = {});
 
 }  // namespace boicp

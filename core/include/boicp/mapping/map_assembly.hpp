@@ -33,11 +33,15 @@ struct PoseEstimate {
 /// ones before doubtful ones, see ChainPoses) into poses and, when some
 /// close loops, optimises the pose graph with each edge weighted by its
 /// confidence (OptimizePoseGraph). The map frame is scan 0's prior world
-/// frame when scan 0 has a prior pose, else scan 0's own frame. Throws
-/// InputError when the constraints leave a scan unreached.
+/// frame when scan 0 has a prior pose, else scan 0's own frame. Of several
+/// drives (`drive_starts`, drives.hpp), one that no constraint joins to the
+/// first is estimated on its own, in its first scan's frame (or prior world
+/// frame). Throws InputError when the constraints leave a scan unreached
+/// from its drive's first scan.
 PoseEstimate EstimatePoses(const std::vector<ScanSource>& scans,
                            const std::vector<PairConstraint>& constraints,
-                           const PoseGraphOptions& options);
+                           const PoseGraphOptions& options,
+                           const std::vector<int>& drive_starts = {});
 
 struct MapBuildSettings {
   OccupancySettings occupancy;
@@ -97,6 +101,14 @@ struct FusionSummary {
 /// cannot be written.
 void WriteTrajectories(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
                        const MapOutputPaths& outputs);
+
+/// Of several drives (`drive_starts`, drives.hpp), each drive's poses (map
+/// frame) as STEM.tum and STEM.kitti, STEM = `stems`[drive], written
+/// atomically. Precondition: one stem per drive, one pose per scan.
+void WriteDriveTrajectories(const std::vector<ScanSource>& scans,
+                            const std::vector<Transform>& poses,
+                            const std::vector<int>& drive_starts,
+                            const std::vector<std::string>& stems);
 
 FusionSummary FuseScans(const std::vector<ScanSource>& scans, const std::vector<Transform>& poses,
                         const MapBuildSettings& settings, const MapOutputPaths& outputs,

@@ -34,6 +34,11 @@ std::string PairName(const PairIndex& p);
 /// direction of the shared data's pairs.csv.
 std::vector<PairIndex> ConsecutivePairs(int num_scans);
 
+/// For each of `num_scans` scans, the smallest index of the scans that
+/// `pairs` connect it to, however indirectly (its own when none): scans with
+/// one label form one connected part. Precondition: indices in range.
+std::vector<int> ConnectedParts(int num_scans, const std::vector<PairIndex>& pairs);
+
 /// Throws InputError naming the first bad pair: an index outside
 /// [0, num_scans), a scan paired with itself, or a pair given twice (in
 /// either direction). With `require_connected`, also throws unless the pairs

@@ -81,10 +81,11 @@ class MapBuilderClient {
   v1::Job Watch(const std::string& job_id,
                 const std::function<void(const v1::JobEvent&)>& on_event = {});
 
-  /// Writes one export to `path`; returns the number of bytes. Throws
+  /// Writes one export to `path`; returns the number of bytes. `drive` K
+  /// >= 1: a trajectory of drive K alone (ExportRequest.drive). Throws
   /// RpcError, or std::runtime_error when the size does not match.
-  uint64_t ExportToFile(const std::string& job_id, v1::ExportFormat format,
-                        const std::string& path);
+  uint64_t ExportToFile(const std::string& job_id, v1::ExportFormat format, const std::string& path,
+                        uint32_t drive = 0);
 
  private:
   /// Authorize, plus the unary deadline when one is set.
