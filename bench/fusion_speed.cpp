@@ -22,10 +22,12 @@
 
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/mapping/map_assembly.hpp"
+#include "boicp/util/percentile.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using boicp::Median;
 using boicp::Point;
 using boicp::Transform;
 
@@ -150,12 +152,6 @@ StageSeconds TimeStages(const std::vector<boicp::ScanSource>& scans,
 std::string Slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 }  // namespace

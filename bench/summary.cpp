@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "boicp/util/percentile.hpp"
 #include "methods.hpp"
 
 namespace boicp::bench {
@@ -16,15 +17,6 @@ std::string Format(const char* format, double value) {
   char text[64];
   std::snprintf(text, sizeof(text), format, value);
   return text;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return NAN;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
 }
 
 double Mean(const std::vector<double>& values) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/util/elapsed.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
 #include "duration_text.hpp"
@@ -14,10 +15,6 @@ namespace boicp::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 void PrintOutcome(const v1::Job& job) {
   const double took =

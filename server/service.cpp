@@ -176,18 +176,20 @@ grpc::ServerWriteReactor<v1::ExportChunk>* MapBuilderService::Export(
   if (status.ok()) {
     status = GuardRpc("Export", [&] {
       const v1::Job job = RequireJob(deps_, request->job_id());
-      const std::optional<std::string> file = ExportFileName(request->format(), request->drive());
-      if (!file && request->drive() > 0) {
-        throw InputError("drive: only the trajectory formats (tum, kitti) are per drive");
-      }
-      if (!file)
-        throw InputError("format: unknown export format " + std::to_string(request->format()));
       const uint32_t drives = std::max(job.drives(), 1u);
       if (request->drive() > drives) {
         throw InputError("drive: job '" + job.job_id() + "' has " + std::to_string(drives) +
                          (drives == 1 ? " drive" : " drives") + ", not " +
                          std::to_string(request->drive()));
       }
+      // The one drive of a job is all of it.
+      const uint32_t drive = drives > 1 ? request->drive() : 0;
+      const std::optional<std::string> file = ExportFileName(request->format(), drive);
+      if (!file && drive > 0) {
+        throw InputError("drive: only the trajectory formats (tum, kitti) are per drive");
+      }
+      if (!file)
+        throw InputError("format: unknown export format " + std::to_string(request->format()));
       if (job.state() != v1::JOB_STATE_SUCCEEDED) {
         throw ServiceError(grpc::StatusCode::FAILED_PRECONDITION,
                            "job '" + job.job_id() + "' is " + rpc::JobStateName(job.state()) +

@@ -1061,6 +1061,17 @@ TEST_F(MapCli, TwoDrivesGiveTheDaemonTheMapsTrajectories) {
   EXPECT_EQ(third.exit_code, 2) << third.err;
   EXPECT_THAT(third.err, HasSubstr("has 2 drives, not 3"));
   EXPECT_EQ(Run("export " + job + " --format bt --drive 1" + server).exit_code, 2);
+
+  // A job of one drive: its drive 1 is all of it.
+  const RunResult one = Run("submit " + first.string() + Quick() + " --wait" + server);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  const std::string single = one.out.substr(0, one.out.find('\n'));
+  const fs::path whole = dir_ / "whole.kitti";
+  ASSERT_EQ(Run("export " + single + " --format kitti -o " + whole.string() + server).exit_code, 0);
+  const RunResult drive_one = Run("export " + single + " --format kitti --drive 1 -o " +
+                                  (dir_ / "one.kitti").string() + server);
+  ASSERT_EQ(drive_one.exit_code, 0) << drive_one.err;
+  EXPECT_EQ(Slurp(dir_ / "one.kitti"), Slurp(whole));
 }
 #endif
 

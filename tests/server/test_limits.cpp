@@ -14,6 +14,7 @@
 #include <gmock/gmock.h>
 
 #include "../support/demo_sequence.hpp"
+#include "boicp/util/elapsed.hpp"
 #include "server_fixture.hpp"
 
 namespace boicp::test {
@@ -360,10 +361,6 @@ std::unique_ptr<grpc::ClientWriter<v1::UploadScanRequest>> OpenUpload(
   *message.mutable_metadata() = metadata;
   if (!writer->Write(message)) return nullptr;
   return writer;
-}
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // An upload that sends its metadata and then nothing, on a connection that

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "boicp/icp/alignment_score.hpp"
-#include "util/percentile.hpp"
+#include "boicp/util/percentile.hpp"
 
 namespace boicp {
 namespace {

@@ -14,8 +14,8 @@
 #include <open3d/io/ImageIO.h>
 
 #include "boicp/util/atomic_file.hpp"
+#include "boicp/util/percentile.hpp"
 #include "mapping/octree_file.hpp"
-#include "util/percentile.hpp"
 
 namespace boicp {
 namespace {

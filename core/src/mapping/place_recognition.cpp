@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "util/percentile.hpp"
+#include "boicp/util/percentile.hpp"
 
 namespace boicp {
 namespace {

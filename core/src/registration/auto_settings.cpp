@@ -10,7 +10,7 @@
 #include "boicp/icp/nearest_neighbors.hpp"
 #include "boicp/icp/preprocess.hpp"
 #include "boicp/util/parallel_for.hpp"
-#include "util/percentile.hpp"
+#include "boicp/util/percentile.hpp"
 
 namespace boicp {
 namespace {
@@ -133,7 +133,9 @@ std::optional<GroundPlane> FindGround(const Points& points, double tolerance, ui
   return GroundPlane{std::acos(std::min(1.0, best_normal.z())), best_offset};
 }
 
-double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
+// The lower of the two middle values: an element of the sample, never a
+// mean of two.
+double LowerMedian(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
 
 // How many times the coordinates of `other` would have to be scaled to match
 // `first`'s scale, when both the RMS radius and the point spacing say so by
@@ -186,7 +188,7 @@ std::string SensorReason(const std::vector<CloudStatistics>& stats,
   std::vector<double> depths;
   for (const CloudStatistics& s : stats) depths.push_back(s.ground_depth);
   std::snprintf(text, sizeof text, ", ground plane %.2f m below the origin",
-                Median(std::move(depths)));
+                LowerMedian(std::move(depths)));
   return reason + text;
 }
 
@@ -223,11 +225,12 @@ FarReturnGate FarReturnGateOf(const Points& points) {
     y.push_back(p.y());
     z.push_back(p.z());
   }
-  const Point centre(Median(std::move(x)), Median(std::move(y)), Median(std::move(z)));
+  const Point centre(LowerMedian(std::move(x)), LowerMedian(std::move(y)),
+                     LowerMedian(std::move(z)));
   std::vector<double> distances;
   for (const Point& p : points) distances.push_back((p - centre).norm());
   // Half the points in one place give no scale to measure "far" by.
-  const double median = Median(std::move(distances));
+  const double median = LowerMedian(std::move(distances));
   return {centre,
           median > 0.0 ? kFarReturnMedians * median : std::numeric_limits<double>::infinity()};
 }
@@ -244,7 +247,7 @@ double PointSpacing(PointSpan cloud, uint64_t seed) {
     tree.KNearest(p, 2, std::numeric_limits<double>::infinity(), indices, squared);
     if (indices.size() == 2) gaps.push_back(std::sqrt(squared[1]));
   }
-  return gaps.empty() ? 0.0 : Median(gaps);
+  return gaps.empty() ? 0.0 : LowerMedian(gaps);
 }
 
 // The finest refinement level: two point spacings, the finest voxel that
@@ -330,9 +333,9 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats,
     chosen.sensor = SensorKind::kLidar;
   }
   chosen.sensor_reason = SensorReason(stats, declared, chosen.sensor, level);
-  chosen.voxel = Median(radii) / kRadiusPerVoxel;
-  chosen.point_spacing = Median(spacings);
-  const double radius = Median(radii);
+  chosen.voxel = LowerMedian(radii) / kRadiusPerVoxel;
+  chosen.point_spacing = LowerMedian(spacings);
+  const double radius = LowerMedian(radii);
   chosen.translation_bounds.setConstant(
       (all_around ? kAllAroundTranslationPerRadius : kConeTranslationPerRadius) * radius);
   if (all_around && level) chosen.translation_bounds.z() = 0.0;  // raised to the minimum below
@@ -351,7 +354,7 @@ ChosenSettings ChooseSettings(const std::vector<CloudStatistics>& stats,
   chosen.map_resolution = chosen.voxel / 3.0;
   // The sparse far tail of a scan costs most of the ray casting (cost grows
   // with the ray's length) and carries the least structure.
-  chosen.map_max_range = Median(ranges);
+  chosen.map_max_range = LowerMedian(ranges);
   return chosen;
 }
 

@@ -18,6 +18,7 @@
 #include "boicp/registration/refinement.hpp"
 #include "boicp/registration/scan_features.hpp"
 #include "boicp/registration/search_space.hpp"
+#include "boicp/util/elapsed.hpp"
 #include "staged_search.hpp"
 
 namespace boicp {
@@ -31,10 +32,6 @@ struct Registered {
   Rung rung = Rung::kFullSearch;
   std::vector<Attempt> attempts;
 };
-
-double SecondsSince(std::chrono::steady_clock::time_point started) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-}
 
 Attempt AttemptOf(AttemptKind kind, const BoIcpConfig& config, const SearchOutcome& outcome,
                   int evaluations, int refined_ends,
