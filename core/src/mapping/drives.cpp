@@ -11,6 +11,11 @@ int DriveOf(const std::vector<int>& drive_starts, int scan) {
                           drive_starts.begin());
 }
 
+std::pair<int, int> DriveScans(const std::vector<int>& drive_starts, int num_scans, size_t drive) {
+  return {drive == 0 ? 0 : drive_starts[drive - 1],
+          drive < drive_starts.size() ? drive_starts[drive] : num_scans};
+}
+
 std::vector<PairIndex> ConsecutivePairsOfDrives(int num_scans,
                                                 const std::vector<int>& drive_starts) {
   std::vector<PairIndex> pairs;
@@ -25,14 +30,12 @@ void ValidateDriveStarts(int num_scans, const std::vector<int>& drive_starts,
   const auto name = [&names](size_t drive) {
     return drive < names.size() ? names[drive] : "drive " + std::to_string(drive + 1);
   };
-  int previous = 0;
   for (size_t d = 0; d <= drive_starts.size(); ++d) {
-    const int end = d < drive_starts.size() ? drive_starts[d] : num_scans;
-    if (end - previous < 2) {
+    const auto [first, end] = DriveScans(drive_starts, num_scans, d);
+    if (end - first < 2) {
       throw InputError(name(d) + ": a drive needs at least 2 scans, it has " +
-                       std::to_string(std::max(end - previous, 0)));
+                       std::to_string(std::max(end - first, 0)));
     }
-    previous = end;
   }
 }
 

@@ -186,8 +186,7 @@ std::vector<LoopCandidate> LoopCandidatesFromPlaces(const std::vector<PlaceDescr
                    });
   size_t budget = 0;
   for (size_t d = 0; d <= drive_starts.size(); ++d) {
-    const int first = d == 0 ? 0 : drive_starts[d - 1];
-    const int end = d < drive_starts.size() ? drive_starts[d] : n;
+    const auto [first, end] = DriveScans(drive_starts, n, d);
     budget += DriveBudget(options.max_place_per_drive_scan, static_cast<size_t>(end - first));
   }
   return TakeBest(best_per_scan, budget, taken, options, drive_starts);

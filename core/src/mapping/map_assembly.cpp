@@ -175,9 +175,8 @@ void WriteDriveTrajectories(const std::vector<ScanSource>& scans,
                             const std::vector<int>& drive_starts,
                             const std::vector<std::string>& stems) {
   for (size_t d = 0; d < stems.size(); ++d) {
-    const auto from = static_cast<std::ptrdiff_t>(d == 0 ? 0 : drive_starts[d - 1]);
-    const auto to = static_cast<std::ptrdiff_t>(
-        d < drive_starts.size() ? drive_starts[d] : static_cast<int>(scans.size()));
+    const auto [first, end] = DriveScans(drive_starts, static_cast<int>(scans.size()), d);
+    const auto from = static_cast<std::ptrdiff_t>(first), to = static_cast<std::ptrdiff_t>(end);
     MapOutputPaths paths;
     paths.trajectory_tum = stems[d] + ".tum";
     paths.trajectory_kitti = stems[d] + ".kitti";

@@ -4,7 +4,9 @@
 // pairs the engine trusts (found by place recognition) join one drive to
 // another. A batch without drive starts is one drive.
 
+#include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "boicp/mapping/map_pairs.hpp"
@@ -15,6 +17,9 @@ namespace boicp {
 /// (each drive's first scan after the first drive's, ascending; empty: one
 /// drive). Drive 0 starts at scan 0.
 int DriveOf(const std::vector<int>& drive_starts, int scan);
+
+/// The scans of drive `drive` (0-based) of `num_scans`: [first, end).
+std::pair<int, int> DriveScans(const std::vector<int>& drive_starts, int num_scans, size_t drive);
 
 /// Scan i onto scan i+1 within each drive of `num_scans` scans: no pair
 /// joins the last scan of one drive to the first of the next.
