@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <set>
 
+#include "boicp/mapping/drives.hpp"
 #include "boicp/mapping/map_pipeline.hpp"
 #include "boicp/mapping/map_preview.hpp"
 #include "boicp/settings/rung_summary.hpp"
@@ -33,10 +34,10 @@ MapOutputPaths LocalOutputPaths(const std::string& out_dir) {
 // drive; of several, "trajectory-NAME", NAME its folder's or bag's name
 // (numbered from 1 when two drives share one).
 std::vector<std::string> DriveTrajectoryStems(const LocalRun& run) {
-  if (run.drives.size() == 1) return {"trajectory"};
+  if (run.drive_paths.size() == 1) return {"trajectory"};
   std::vector<std::string> names;
-  for (const LocalDrive& drive : run.drives) {
-    fs::path path = fs::path(drive.path).lexically_normal();
+  for (const std::string& drive : run.drive_paths) {
+    fs::path path = fs::path(drive).lexically_normal();
     if (!path.has_filename()) path = path.parent_path();  // "folder/"
     names.push_back(path.stem().string());
   }
@@ -86,7 +87,7 @@ MapOutputSummary WriteListingAndPreview(const LocalRun& run, const AssembledMap&
     listing.push_back(PairListingJson(run.batch.scans, r));
   }
   WriteTextFileAtomically((dir / "pairs.json").string(), listing.dump(1) + "\n");
-  if (run.drives.size() > 1) {
+  if (run.drive_paths.size() > 1) {
     std::vector<std::string> stems;
     for (const std::string& stem : DriveTrajectoryStems(run))
       stems.push_back((dir / stem).string());
@@ -187,14 +188,16 @@ nlohmann::json MapSummaryJson(const LocalRun& run, const MapOutputSummary& summa
   // outputs too.
   json drives = json::array();
   const std::vector<std::string> stems = DriveTrajectoryStems(run);
-  for (size_t d = 0; d < run.drives.size(); ++d) {
+  for (size_t d = 0; d < run.drive_paths.size(); ++d) {
+    const auto [first, end] =
+        DriveScans(run.batch.pairing.drive_starts, static_cast<int>(run.batch.scans.size()), d);
     for (const char* extension : {".tum", ".kitti"}) {
       const std::string name = stems[d] + extension;
       outputs[name] = (fs::path(out_dir) / name).string();
     }
-    drives.push_back({{"path", run.drives[d].path},
-                      {"first_scan", run.drives[d].first_scan},
-                      {"scans", run.drives[d].scans},
+    drives.push_back({{"path", run.drive_paths[d]},
+                      {"first_scan", first},
+                      {"scans", end - first},
                       {"trajectory_tum", stems[d] + ".tum"},
                       {"trajectory_kitti", stems[d] + ".kitti"}});
   }

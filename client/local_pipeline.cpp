@@ -157,9 +157,8 @@ LocalRun RunOfScans(const MapSettings& settings, std::vector<ScanFolder> folders
       throw InputError(wheres[d] + ": a " + (folders.size() > 1 ? "drive" : "map") +
                        " needs at least 2 scans, the selection has " + std::to_string(n));
     }
-    const int first = static_cast<int>(scans.size());
-    if (d > 0) pairing.drive_starts.push_back(first);
-    run.drives.push_back({wheres[d], first, n});
+    if (d > 0) pairing.drive_starts.push_back(static_cast<int>(scans.size()));
+    run.drive_paths.push_back(wheres[d]);
     run.description += (d > 0 ? "; " : "") +
                        (folders.size() > 1 ? wheres[d] + ": " : std::string()) + folder.description;
     for (ScanSource& scan : folder.scans) scans.push_back(std::move(scan));

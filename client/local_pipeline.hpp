@@ -46,17 +46,12 @@ nlohmann::json MapSettingsToJson(const MapSettings& settings);
 /// Throws InputError naming `source` when a field is missing or mistyped.
 MapSettings MapSettingsFromJson(const nlohmann::json& json, const std::string& source);
 
-/// One drive of a run: its folder or bag and its scans in batch.scans.
-struct LocalDrive {
-  std::string path;
-  int first_scan = 0;
-  int scans = 0;
-};
-
 /// A run resolved from its settings.
 struct LocalRun {
   MapSettings settings;
-  std::vector<LocalDrive> drives;         // settings.path's, then more_paths'; one for one drive
+  /// Each drive's folder or bag: settings.path, then more_paths (its scans:
+  /// DriveScans(batch.pairing.drive_starts, ...)).
+  std::vector<std::string> drive_paths;
   ScanLayout layout = ScanLayout::kAuto;  // the folder's layout (never kAuto)
   std::string description;                // the folder in one line (ScanFolder::description)
   MapBatch batch;                         // one thread per registration

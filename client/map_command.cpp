@@ -118,10 +118,10 @@ int RunMap(MapFlags flags) {
   if (sharded) CheckShardManifest(run, out);
   // Shards fuse nothing, but their merge would refuse what this refuses.
   ChooseMapRunSettings(run, flags.threads, flags.max_fusion_mb);
-  if (run.drives.size() == 1) {
+  if (run.drive_paths.size() == 1) {
     std::fprintf(stderr, "%s: %s\n", run.settings.path.c_str(), run.description.c_str());
   } else {
-    std::fprintf(stderr, "%zu drives, mapped into the first's frame: %s\n", run.drives.size(),
+    std::fprintf(stderr, "%zu drives, mapped into the first's frame: %s\n", run.drive_paths.size(),
                  run.description.c_str());
   }
   PrintRunSettings(run);
