@@ -2,24 +2,28 @@
 # Loop closure on whole drives, side by side in one run: each drive mapped
 # with --loops off and with the default --loops auto, both scored by
 # `boicp eval` against the drive's reference -> OUT/loops.md.
-# Usage: bench/loops.sh OUT [--bin DIR] [--data-root DIR] [--vlp16]
+# Usage: bench/loops.sh OUT [--bin DIR] [--data-root DIR] [--vlp16] [--drift]
 #   drives: 7-Scenes redkitchen frames 0-495 every 5th (KinectFusion poses),
-#   a generated 300-scan drive out and back (its truth.kitti), and with
-#   --vlp16 the VLP-16 drive (its revisits.csv; about 15 minutes on 2 cores).
+#   a generated 300-scan drive out and back (its truth.kitti), with --vlp16
+#   the VLP-16 drive (its revisits.csv; 40-70 minutes on 2 cores), and with
+#   --drift a generated 1000-scan drive out and back logged as a throttled
+#   LiDAR log is (demo-data --drift).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-out="" bin="build/bin" data="../shared/data" vlp16=0
+out="" bin="build/bin" data="../shared/data" vlp16=0 drift=0
+usage="usage: bench/loops.sh OUT [--bin DIR] [--data-root DIR] [--vlp16] [--drift]"
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) bin="$2"; shift 2 ;;
     --data-root) data="$2"; shift 2 ;;
     --vlp16) vlp16=1; shift ;;
-    -*) echo "usage: bench/loops.sh OUT [--bin DIR] [--data-root DIR] [--vlp16]" >&2; exit 2 ;;
+    --drift) drift=1; shift ;;
+    -*) echo "$usage" >&2; exit 2 ;;
     *) out="$1"; shift ;;
   esac
 done
-[ -n "$out" ] || { echo "usage: bench/loops.sh OUT [--bin DIR] [--data-root DIR] [--vlp16]" >&2; exit 2; }
+[ -n "$out" ] || { echo "$usage" >&2; exit 2; }
 if [ ! -d "$data/7scenes_redkitchen" ]; then
   echo "bench/loops.sh: no shared data at $data; nothing to measure" >&2
   exit 77
@@ -40,6 +44,12 @@ generated="$out/drives/generated_300_loop"
 [ -f "$generated/truth.kitti" ] || "$boicp" demo-data --scans 300 --loop -o "$generated" >/dev/null
 
 drives=("7scenes_every_5th|$kitchen|$kitchen" "generated_300_loop|$generated|$generated/truth.kitti")
+if [ "$drift" = 1 ]; then
+  drifting="$out/drives/generated_1000_drift"
+  [ -f "$drifting/truth.kitti" ] ||
+    "$boicp" demo-data --scans 1000 --loop --drift -o "$drifting" >/dev/null
+  drives+=("generated_1000_drift|$drifting|$drifting/truth.kitti")
+fi
 if [ "$vlp16" = 1 ]; then
   drives+=("vlp16_loop|$data/vlp16_loop/pcd|$data/vlp16_loop/revisits.csv")
 fi

@@ -26,8 +26,9 @@ struct DemoFlags {
   std::string out = "demo";
   uint64_t seed = 7;
   double yaw_deg = 135.0;
-  int scans = 0;      // 0: the pair; otherwise a drive of this many scans
-  bool loop = false;  // the drive comes back to its start
+  int scans = 0;       // 0: the pair; otherwise a drive of this many scans
+  bool loop = false;   // the drive comes back to its start
+  bool drift = false;  // irregular spacing and sweeps that are not de-skewed
 };
 
 void WriteTransform(const std::string& path, const Transform& T) {
@@ -57,7 +58,7 @@ std::string ZeroPadded(int value, int digits) {
 // name order) and their true poses T_world_scan in truth.kitti. Scans are
 // generated and written one at a time, so any length fits in memory.
 void WriteDrive(const DemoFlags& f) {
-  const SyntheticDrive drive(f.scans, f.seed, f.loop);
+  const SyntheticDrive drive(f.scans, f.seed, f.loop, f.drift);
   const int digits = IndexDigits(f.scans);
   std::vector<Transform> poses;
   for (int i = 0; i < drive.size(); ++i) {
@@ -74,6 +75,7 @@ void WriteDrive(const DemoFlags& f) {
 
 int RunDemoData(const DemoFlags& f) {
   if (f.loop && f.scans == 0) throw InputError("--loop needs --scans N (a drive)");
+  if (f.drift && f.scans == 0) throw InputError("--drift needs --scans N (a drive)");
   std::filesystem::create_directories(f.out);
   if (f.scans != 0) {
     if (f.scans < 2) throw InputError("--scans must be 0 (a pair) or at least 2");
@@ -110,6 +112,10 @@ CommandRunner AddDemoDataCommand(CLI::App& app) {
   app.add_flag("--loop", flags->loop,
                "With --scans: drive out along the street and back in the other lane, ending "
                "beside the start");
+  app.add_flag("--drift", flags->drift,
+               "With --scans: log the drive as a throttled LiDAR log is, 0.5-7 m and up to "
+               "0.75 rad between scans, each swept while moving and not de-skewed, so that "
+               "chained registration drifts");
   return [flags] { return RunCommand("demo-data", [&] { return RunDemoData(*flags); }); };
 }
 

@@ -5,6 +5,8 @@
 #include <cstdio>
 
 #include "boicp/mapping/batch_pair.hpp"
+#include "boicp/mapping/map_pipeline.hpp"
+#include "boicp/mapping/untrusted_scans.hpp"
 #include "boicp/util/elapsed.hpp"
 #include "cli_parsing.hpp"
 #include "commands.hpp"
@@ -28,6 +30,9 @@ void PrintOutcome(const v1::Job& job) {
                    DoubtfulSummary(static_cast<int>(job.pairs_doubtful()),
                                    static_cast<int>(job.pairs_done()))
                        .c_str());
+      for (const std::string& line : MapOutcomeLines(job)) {
+        std::fprintf(stderr, "%s\n", PrintableText(line).c_str());
+      }
       return;
     case v1::JOB_STATE_FAILED:
       throw JobEndedBadly("job " + job.job_id() + " failed: " + job.error());
@@ -42,6 +47,23 @@ void PrintOutcome(const v1::Job& job) {
 }
 
 }  // namespace
+
+std::vector<std::string> MapOutcomeLines(const v1::Job& job,
+                                         const std::vector<std::string>& scan_names) {
+  std::vector<std::string> names;
+  for (const uint32_t scan : job.untrusted_scans()) {
+    names.push_back(scan < scan_names.size() && !scan_names[scan].empty()
+                        ? scan_names[scan]
+                        : "#" + std::to_string(scan));
+  }
+  std::vector<std::string> lines;
+  if (!names.empty()) lines.push_back(UntrustedScansLine(names, job.untrusted_left_out()));
+  if (job.loop_candidates() > 0) {
+    lines.push_back(LoopsClosedText(static_cast<int>(job.loops_closed()),
+                                    static_cast<int>(job.loop_candidates())));
+  }
+  return lines;
+}
 
 std::string GapLine(uint32_t skipped) {
   return "watch fell behind: " + std::to_string(skipped) + " finished pair" +

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "boicp/rpc/proto_convert.hpp"
 #include "remote_options.hpp"
@@ -49,6 +50,13 @@ std::string GapLine(uint32_t skipped);
 
 /// "[#####...............]": done of total in `width` characters.
 std::string ProgressBar(uint32_t done, uint32_t total, int width = 20);
+
+/// What a succeeded job's map says beyond its pairs: the scans without a
+/// trusted pair, each named by `scan_names[index]` where it has one and by
+/// "#index" otherwise, and the loops closed. Lines that would be empty are
+/// left out.
+std::vector<std::string> MapOutcomeLines(const v1::Job& job,
+                                         const std::vector<std::string>& scan_names = {});
 
 /// Checks the job exists (a control call with a short deadline), follows
 /// WatchJob until its final state with progress on stderr, and prints the

@@ -74,6 +74,13 @@ void PrintSummary(const v1::JobResults& results) {
   if (!job.error().empty()) std::printf("error       %s\n", PrintableText(job.error()).c_str());
   if (job.has_settings())
     std::printf("settings    %s\n", DescribeChosenSettings(job.settings()).c_str());
+  std::vector<std::string> scan_ids(static_cast<size_t>(job.num_scans()));
+  for (const v1::TrajectoryPose& pose : results.trajectory()) {
+    if (pose.index() < scan_ids.size()) scan_ids[pose.index()] = pose.scan_id();
+  }
+  for (const std::string& line : MapOutcomeLines(job, scan_ids)) {
+    std::printf("map         %s\n", PrintableText(line).c_str());
+  }
   if (results.pairs_size() > 0) PrintPairs(results);
 }
 

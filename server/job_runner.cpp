@@ -265,10 +265,17 @@ class JobRun : public MapProgressSink {
       spdlog::warn("job {}: {} points lie beyond the OctoMap's key range and were left out",
                    job_.job_id(), map.fusion.points_out_of_range);
     }
+    const LoopStageSummary loops = SummariseLoops(result.pairs, map.in_graph);
+    job_.clear_untrusted_scans();
+    for (const int scan : map.untrusted_scans)
+      job_.add_untrusted_scans(static_cast<uint32_t>(scan));
+    job_.set_untrusted_left_out(map.untrusted_left_out);
+    job_.set_loop_candidates(static_cast<uint32_t>(loops.candidates));
+    job_.set_loops_closed(static_cast<uint32_t>(loops.closed));
     for (const std::string& line :
          {BridgeSummaryLine(result.pairs),
           UntrustedScansLine(spec_.batch.scans, map.untrusted_scans, map.untrusted_left_out),
-          SummariseLoops(result.pairs, map.in_graph).Line()}) {
+          loops.Line()}) {
       if (!line.empty()) spdlog::info("job {}: {}", job_.job_id(), line);
     }
     std::vector<v1::TrajectoryPose> trajectory;

@@ -30,6 +30,7 @@
 #include "boicp/io/scan_folder.hpp"
 #include "boicp/io/synthetic_scene.hpp"
 #include "boicp/io/trajectory_io.hpp"
+#include "boicp/mapping/map_pipeline.hpp"
 #include "boicp/registration/bo_icp.hpp"
 
 #ifdef BOICP_TEST_WITH_DAEMON
@@ -108,6 +109,19 @@ class MapCli : public ::testing::Test {
       std::snprintf(name, sizeof(name), "scan%03d.xyz", i);
       WriteXyz((scans / name).string(), SimulateScan(world, pose, 30.0, 0.02, 100 + i));
     }
+    return scans;
+  }
+
+  // MakeDrive(6) with scan 3 replaced by noise that no other scan matches.
+  fs::path MakeDriveWithNoiseAt3() {
+    const fs::path scans = MakeDrive(6);
+    Points noise;
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> coordinate(-20.0, 20.0);
+    for (int i = 0; i < 4000; ++i) {
+      noise.emplace_back(coordinate(random), coordinate(random), 0.1 * coordinate(random));
+    }
+    WriteXyz((scans / "scan003.xyz").string(), noise);
     return scans;
   }
 
@@ -820,14 +834,7 @@ TEST_F(MapCli, ADoubtfulPairIsBridgedByItselfTheOtherWayRound) {
 // bridge 2 -> 4 holds the chain together; scan 3 is named, kept in the
 // trajectory, and fused only with --untrusted-scans place.
 TEST_F(MapCli, ADoubtfulScanIsBridgedNamedAndLeftOut) {
-  const fs::path scans = MakeDrive(6);
-  Points noise;
-  std::mt19937 random(3);
-  std::uniform_real_distribution<double> coordinate(-20.0, 20.0);
-  for (int i = 0; i < 4000; ++i) {
-    noise.emplace_back(coordinate(random), coordinate(random), 0.1 * coordinate(random));
-  }
-  WriteXyz((scans / "scan003.xyz").string(), noise);
+  const fs::path scans = MakeDriveWithNoiseAt3();
 
   const fs::path out = dir_ / "out";
   const RunResult r = Run("map " + scans.string() + " -o " + out.string() + Quick() + " --json");
@@ -1035,7 +1042,9 @@ TEST_F(MapCli, TwoDrivesGiveTheDaemonTheMapsTrajectories) {
   const fs::path first = MakeDrive(8), second = SplitDrive(first, 4, "second");
   const fs::path out = dir_ / "out";
   const std::string drives = " " + first.string() + " " + second.string() + Quick();
-  ASSERT_EQ(Run("map" + drives + " -o " + out.string()).exit_code, 0);
+  const RunResult mapped = Run("map" + drives + " -o " + out.string() + " --json");
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.err;
+  const json map_summary = json::parse(mapped.out);
 
   test::DaemonProcess daemon({"--data-dir", (dir_ / "daemon").string(), "--workers", "2"},
                              (dir_ / "daemon.log").string());
@@ -1043,8 +1052,13 @@ TEST_F(MapCli, TwoDrivesGiveTheDaemonTheMapsTrajectories) {
   const RunResult submitted = Run("submit" + drives + " --wait" + server);
   ASSERT_EQ(submitted.exit_code, 0) << submitted.err << daemon.Log();
   const std::string job = submitted.out.substr(0, submitted.out.find('\n'));
-  const RunResult shown = Run("show " + job + " --json" + server);
-  EXPECT_EQ(json::parse(shown.out)["drives"], 2);
+  const json shown = json::parse(Run("show " + job + " --json" + server).out);
+  EXPECT_EQ(shown["drives"], 2);
+  ASSERT_GT(map_summary["loop_candidates"].get<int>(), 0) << "the place pairs between the drives";
+  EXPECT_EQ(shown["loop_candidates"], map_summary["loop_candidates"]);
+  EXPECT_EQ(shown["loops_closed"], map_summary["loops_closed"]);
+  EXPECT_THAT(submitted.err, HasSubstr(LoopsClosedText(map_summary["loops_closed"].get<int>(),
+                                                       map_summary["loop_candidates"].get<int>())));
 
   const fs::path exported = dir_ / "second.kitti";
   const RunResult r =
@@ -1072,6 +1086,28 @@ TEST_F(MapCli, TwoDrivesGiveTheDaemonTheMapsTrajectories) {
                                   (dir_ / "one.kitti").string() + server);
   ASSERT_EQ(drive_one.exit_code, 0) << drive_one.err;
   EXPECT_EQ(Slurp(dir_ / "one.kitti"), Slurp(whole));
+}
+
+// The daemon names a scan without a trusted pair as `map` does: in the job
+// (by index), in the outcome `submit --wait` prints, and in `show`.
+TEST_F(MapCli, TheDaemonNamesAScanWithoutATrustedPair) {
+  const fs::path scans = MakeDriveWithNoiseAt3();
+  test::DaemonProcess daemon({"--data-dir", (dir_ / "daemon").string(), "--workers", "2"},
+                             (dir_ / "daemon.log").string());
+  const std::string server = " --server " + daemon.address();
+  const RunResult submitted = Run("submit " + scans.string() + Quick() + " --wait" + server);
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.err << daemon.Log();
+  EXPECT_THAT(submitted.err, HasSubstr("1 scan has no trusted pair; left out of the map "
+                                       "(--untrusted-scans place fuses them): #3"));
+  const std::string job = submitted.out.substr(0, submitted.out.find('\n'));
+  const json shown = json::parse(Run("show " + job + " --json" + server).out);
+  EXPECT_EQ(shown["untrusted_scans"], json::array({3}));
+  EXPECT_EQ(shown["untrusted_left_out"], true);
+  const std::string scan_id = shown["trajectory"][3]["scan_id"].get<std::string>();
+  EXPECT_THAT(Run("show " + job + server).out,
+              HasSubstr("map         1 scan has no trusted pair; left out of the map "
+                        "(--untrusted-scans place fuses them): " +
+                        scan_id));
 }
 #endif
 

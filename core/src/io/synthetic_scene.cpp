@@ -153,46 +153,110 @@ Transform PoseFromYawTranslation(double yaw, const Eigen::Vector3d& translation)
   return T;
 }
 
-SyntheticDrive::SyntheticDrive(int num_scans, uint64_t seed, bool loop)
-    : num_scans_(std::max(num_scans, 0)), seed_(seed), loop_(loop) {
+namespace {
+
+// A drifting drive's sweep: 0.1 s at 10 m/s, turning at 0.2 rad/s.
+constexpr double kSweepTravel = 1.0;  // metres
+constexpr double kSweepTurn = 0.02;   // radians
+
+}  // namespace
+
+Points SimulateSweptScan(const Points& world, const Transform& T_world_start,
+                         const Eigen::Vector3d& travel, double turn, double range,
+                         double noise_sigma, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_sigma);
+  const Transform T_start_world = T_world_start.inverse();
+  Points scan;
+  for (const Point& p : world) {
+    const Point at_start =
+        T_start_world.topLeftCorner<3, 3>() * p + T_start_world.topRightCorner<3, 1>();
+    if (at_start.norm() > range + travel.norm()) continue;
+    const double fraction = (std::atan2(at_start.y(), at_start.x()) + M_PI) / (2.0 * M_PI);
+    Transform T_world_now = T_world_start;
+    T_world_now.topLeftCorner<3, 3>() *=
+        Eigen::AngleAxisd(fraction * turn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T_world_now.topRightCorner<3, 1>() += fraction * travel;
+    const Point q =
+        T_world_now.topLeftCorner<3, 3>().transpose() * (p - T_world_now.topRightCorner<3, 1>());
+    if (q.norm() > range) continue;
+    scan.push_back(noise_sigma > 0 ? Point(q + Point(noise(rng), noise(rng), noise(rng))) : q);
+  }
+  return scan;
+}
+
+SyntheticDrive::SyntheticDrive(int num_scans, uint64_t seed, bool loop, bool drift)
+    : num_scans_(std::max(num_scans, 0)), seed_(seed), loop_(loop), drift_(drift) {
+  // A loop's outbound leg is its first half, rounded up; the way back runs
+  // the same stations in reverse order in the other lane.
+  const int outbound = loop_ ? (num_scans_ + 1) / 2 : num_scans_;
+  std::mt19937_64 rng(MixSeed(seed, 0xD81F7));
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double x = kFirstScanX, yaw = 0.0;
+  for (int i = 0; i < num_scans_; ++i) {
+    if (!drift_) {
+      if (i < outbound) station_x_.push_back(kFirstScanX + kScanSpacing * i);
+      yaw_.push_back(0.04 * i);
+      continue;
+    }
+    if (i > 0) {
+      // Mostly 0.5-4 m on, one step in ten 4-7 m; mostly a small turn, one in
+      // twenty a sharp one.
+      const bool long_step = unit(rng) < 0.1;
+      const double step = long_step ? 4.0 + 3.0 * unit(rng) : 0.5 + 3.5 * unit(rng);
+      const double turn = -0.05 + 0.2 * unit(rng);
+      const bool sharp_turn = unit(rng) < 0.05;
+      const double sharp = sharp_turn ? 0.35 + 0.25 * unit(rng) : 0.0;
+      if (i < outbound) x += step;
+      yaw += turn + sharp;
+    }
+    if (i < outbound) station_x_.push_back(x);
+    yaw_.push_back(yaw);
+  }
   segments_.push_back(MakeSyntheticStreet(seed));
   double farthest = kFirstScanX;
-  for (int i = 0; i < num_scans_; ++i) farthest = std::max(farthest, Pose(i)(0, 3));
+  for (const double station : station_x_) farthest = std::max(farthest, station);
   const int last_segment =
       static_cast<int>(std::ceil((farthest + kScanRange - kStreetEnd) / kSegmentLength));
   for (int k = 1; k <= last_segment; ++k) segments_.push_back(MakeStreetSegment(seed, k));
 }
 
 Transform SyntheticDrive::Pose(int index) const {
-  // A loop's outbound leg is its first half, rounded up; the way back runs
-  // the same stations in reverse order in the other lane.
-  const int outbound = loop_ ? (num_scans_ + 1) / 2 : num_scans_;
+  const int outbound = static_cast<int>(station_x_.size());
   const bool returning = index >= outbound;
   const int station = returning ? 2 * outbound - 1 - index : index;
   const double lane = returning ? kReturnLane : 0.0;
-  return PoseFromYawTranslation(0.04 * index, {kFirstScanX + kScanSpacing * station,
-                                               lane + 0.4 * std::sin(0.7 * index), 1.8});
+  return PoseFromYawTranslation(
+      yaw_.at(static_cast<size_t>(index)),
+      {station_x_.at(static_cast<size_t>(station)), lane + 0.4 * std::sin(0.7 * index), 1.8});
 }
 
 SyntheticScan SyntheticDrive::Scan(int index) const {
   if (index < 0 || index >= num_scans_) throw std::out_of_range("SyntheticDrive::Scan: index");
   SyntheticScan scan;
   scan.T_world_scan = Pose(index);
+  const bool returning = index >= static_cast<int>(station_x_.size());
+  const Eigen::Vector3d travel(returning ? -kSweepTravel : kSweepTravel, 0.0, 0.0);
+  const auto simulate = [&](const Points& world, uint64_t seed) {
+    return drift_ ? SimulateSweptScan(world, scan.T_world_scan, travel, kSweepTurn, kScanRange,
+                                      kScanNoise, seed)
+                  : SimulateScan(world, scan.T_world_scan, kScanRange, kScanNoise, seed);
+  };
   const uint64_t scan_seed = seed_ + 100 + static_cast<uint64_t>(index);
-  scan.points = SimulateScan(segments_[0], scan.T_world_scan, kScanRange, kScanNoise, scan_seed);
+  scan.points = simulate(segments_[0], scan_seed);
   const double x = scan.T_world_scan(0, 3);
+  const double reach = kScanRange + (drift_ ? kSweepTravel : 0.0);
   for (size_t k = 1; k < segments_.size(); ++k) {
     const double x0 = SegmentStart(static_cast<int>(k));
-    if (x + kScanRange < x0 || x - kScanRange > x0 + kSegmentLength) continue;
-    const Points seen = SimulateScan(segments_[k], scan.T_world_scan, kScanRange, kScanNoise,
-                                     MixSeed(scan_seed, k));
+    if (x + reach < x0 || x - reach > x0 + kSegmentLength) continue;
+    const Points seen = simulate(segments_[k], MixSeed(scan_seed, k));
     scan.points.insert(scan.points.end(), seen.begin(), seen.end());
   }
   return scan;
 }
 
-std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed, bool loop) {
-  const SyntheticDrive drive(num_scans, seed, loop);
+std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed, bool loop, bool drift) {
+  const SyntheticDrive drive(num_scans, seed, loop, drift);
   std::vector<SyntheticScan> scans;
   scans.reserve(static_cast<size_t>(drive.size()));
   for (int i = 0; i < drive.size(); ++i) scans.push_back(drive.Scan(i));

@@ -341,16 +341,18 @@ LoopStageSummary SummariseLoops(const RegisteredPairs& registered,
   return summary;
 }
 
+std::string LoopsClosedText(int closed, int candidates) {
+  return std::to_string(closed) + (closed == 1 ? " loop" : " loops") + " closed of " +
+         std::to_string(candidates) + (candidates == 1 ? " candidate" : " candidates");
+}
+
 std::string LoopStageSummary::Line() const {
   if (candidates == 0) return "";
-  char line[200];
-  std::snprintf(line, sizeof(line),
-                "%d %s closed of %d %s; verifying them took %.0f s, %.0f %% of the other "
-                "pairs' %.0f s",
-                closed, closed == 1 ? "loop" : "loops", candidates,
-                candidates == 1 ? "candidate" : "candidates", seconds,
+  char cost[120];
+  std::snprintf(cost, sizeof(cost),
+                "; verifying them took %.0f s, %.0f %% of the other pairs' %.0f s", seconds,
                 other_seconds > 0.0 ? 100.0 * seconds / other_seconds : 0.0, other_seconds);
-  return line;
+  return LoopsClosedText(closed, candidates) + cost;
 }
 
 std::vector<PairIndex> PairsInGraph(const GraphEdges& edges, const PoseEstimate& estimate) {

@@ -41,16 +41,19 @@ std::vector<std::string> ScanFileNames(const std::vector<ScanSource>& all,
   return names;
 }
 
-std::string UntrustedScansLine(const std::vector<ScanSource>& all, const std::vector<int>& scans,
-                               bool left_out) {
-  if (scans.empty()) return "";
-  std::string line = std::to_string(scans.size()) +
-                     (scans.size() == 1 ? " scan has" : " scans have") + " no trusted pair; " +
+std::string UntrustedScansLine(const std::vector<std::string>& names, bool left_out) {
+  if (names.empty()) return "";
+  std::string line = std::to_string(names.size()) +
+                     (names.size() == 1 ? " scan has" : " scans have") + " no trusted pair; " +
                      (left_out ? "left out of the map (--untrusted-scans place fuses them): "
                                : "placed by the best doubtful pair: ");
-  const std::vector<std::string> names = ScanFileNames(all, scans);
   for (size_t k = 0; k < names.size(); ++k) line += (k > 0 ? ", " : "") + names[k];
   return line;
+}
+
+std::string UntrustedScansLine(const std::vector<ScanSource>& all, const std::vector<int>& scans,
+                               bool left_out) {
+  return UntrustedScansLine(ScanFileNames(all, scans), left_out);
 }
 
 }  // namespace boicp

@@ -21,6 +21,16 @@ Points MakeSyntheticStreet(uint64_t seed, double density = 40.0);
 Points SimulateScan(const Points& world, const Transform& T_world_sensor, double range,
                     double noise_sigma, uint64_t seed);
 
+/// SimulateScan for a spinning sensor whose sweep starts at T_world_start:
+/// a point at azimuth a (radians from -pi) is measured at the sweep's
+/// fraction (a + pi) / 2 pi, from the sensor moved by that fraction of
+/// `travel` (metres, world frame) and turned by that fraction of `turn`
+/// (radians about its z), and kept in that moved sensor's frame, as a scan
+/// that is not de-skewed keeps it.
+Points SimulateSweptScan(const Points& world, const Transform& T_world_start,
+                         const Eigen::Vector3d& travel, double turn, double range,
+                         double noise_sigma, uint64_t seed);
+
 /// Pose with yaw (radians, about z) and translation (metres).
 Transform PoseFromYawTranslation(double yaw, const Eigen::Vector3d& translation);
 
@@ -43,14 +53,20 @@ Points MakeStreetSegment(uint64_t seed, int segment, double density = 40.0);
 /// ground with 2 cm noise. With `loop`, the second half of the drive comes
 /// back in the other lane and ends beside the start. Scans are generated one
 /// at a time, so a long drive needs memory for its street only.
+///
+/// With `drift`, the drive is logged as a throttled LiDAR log is: scans
+/// 0.5-7 m apart and turns of up to 0.75 rad between them, drawn from the
+/// seed, and each scan swept over 0.1 s while the sensor moves 1 m and turns
+/// 0.02 rad, without de-skewing. Chained registration of such scans drifts
+/// as a LiDAR odometry does.
 class SyntheticDrive {
  public:
   /// Precondition: num_scans >= 0. Builds the street the drive sees.
-  SyntheticDrive(int num_scans, uint64_t seed, bool loop = false);
+  SyntheticDrive(int num_scans, uint64_t seed, bool loop = false, bool drift = false);
 
   int size() const { return num_scans_; }
 
-  /// True T_world_scan of scan `index` in [0, size()).
+  /// True T_world_scan of scan `index` in [0, size()): where its sweep starts.
   Transform Pose(int index) const;
 
   /// Scan `index` in [0, size()): the same points for the same seed, and for
@@ -61,10 +77,14 @@ class SyntheticDrive {
   int num_scans_;
   uint64_t seed_;
   bool loop_;
-  std::vector<Points> segments_;  // [0] = MakeSyntheticStreet, then MakeStreetSegment(k)
+  bool drift_;
+  std::vector<double> station_x_;  // metres along the street, one per outbound scan
+  std::vector<double> yaw_;        // radians, one per scan
+  std::vector<Points> segments_;   // [0] = MakeSyntheticStreet, then MakeStreetSegment(k)
 };
 
 /// Every scan of SyntheticDrive(num_scans, seed, loop), in memory at once.
-std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed, bool loop = false);
+std::vector<SyntheticScan> MakeSyntheticDrive(int num_scans, uint64_t seed, bool loop = false,
+                                              bool drift = false);
 
 }  // namespace boicp

@@ -94,6 +94,9 @@ struct LoopStageSummary {
   std::string Line() const;
 };
 
+/// "3 loops closed of 12 candidates".
+std::string LoopsClosedText(int closed, int candidates);
+
 LoopStageSummary SummariseLoops(const RegisteredPairs& registered,
                                 const std::vector<PairIndex>& in_graph);
 

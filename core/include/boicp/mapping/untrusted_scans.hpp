@@ -35,9 +35,12 @@ std::vector<std::string> ScanFileNames(const std::vector<ScanSource>& all,
                                        const std::vector<int>& scans);
 
 /// "2 scans have no trusted pair; left out of the map (--untrusted-scans
-/// place fuses them): a.pcd, b.pcd", naming each by its file name; empty
-/// when `scans` is empty.
+/// place fuses them): a.pcd, b.pcd", naming each scan as `names` does;
+/// empty when `names` is empty.
 /// `left_out`: whether they were left out of the fusion.
+std::string UntrustedScansLine(const std::vector<std::string>& names, bool left_out);
+
+/// The line above, naming each of `scans` (indices into `all`) by its file name.
 std::string UntrustedScansLine(const std::vector<ScanSource>& all, const std::vector<int>& scans,
                                bool left_out);
 
