@@ -27,23 +27,18 @@ struct ExportFlags {
   uint32_t drive = 0;  // a trajectory of this drive alone (1-based); 0 = every scan
 };
 
-struct ExportKind {
-  v1::ExportFormat format;
-  std::string default_name;
-};
-
-const std::map<std::string, ExportKind>& ExportKinds() {
-  static const std::map<std::string, ExportKind> kinds = {
-      {"bt", {v1::EXPORT_FORMAT_OCTOMAP_BT, "map.bt"}},
-      {"ot", {v1::EXPORT_FORMAT_OCTOMAP_OT, "map.ot"}},
-      {"ply", {v1::EXPORT_FORMAT_POINT_CLOUD_PLY, "map.ply"}},
-      {"tum", {v1::EXPORT_FORMAT_TRAJECTORY_TUM, "trajectory.tum"}},
-      {"kitti", {v1::EXPORT_FORMAT_TRAJECTORY_KITTI, "trajectory.kitti"}}};
+const std::map<std::string, v1::ExportFormat>& ExportKinds() {
+  static const std::map<std::string, v1::ExportFormat> kinds = {
+      {"bt", v1::EXPORT_FORMAT_OCTOMAP_BT},
+      {"ot", v1::EXPORT_FORMAT_OCTOMAP_OT},
+      {"ply", v1::EXPORT_FORMAT_POINT_CLOUD_PLY},
+      {"tum", v1::EXPORT_FORMAT_TRAJECTORY_TUM},
+      {"kitti", v1::EXPORT_FORMAT_TRAJECTORY_KITTI}};
   return kinds;
 }
 
 // --format, else the extension of -o; -o defaults to the daemon's file name.
-std::pair<ExportKind, std::string> ResolveFormat(const ExportFlags& f) {
+std::pair<v1::ExportFormat, std::string> ResolveFormat(const ExportFlags& f) {
   std::string name = f.format;
   if (name.empty() && !f.output.empty()) {
     name = fs::path(f.output).extension().string();
@@ -57,11 +52,11 @@ std::pair<ExportKind, std::string> ResolveFormat(const ExportFlags& f) {
     if (f.output.empty()) throw InputError("--format: needed when -o is not given" + choices);
     throw InputError("--format: not implied by -o '" + f.output + "'" + choices);
   }
-  std::string output = f.output;
-  if (output.empty() && f.drive > 0) {
-    output = "trajectory-drive" + std::to_string(f.drive) + "." + name;
-  }
-  return {found->second, output.empty() ? found->second.default_name : output};
+  if (!f.output.empty()) return {found->second, f.output};
+  // A drive of a format that has none (the daemon refuses it) keeps the map's name.
+  return {
+      found->second,
+      rpc::ExportFileName(found->second, f.drive).value_or(*rpc::ExportFileName(found->second))};
 }
 
 // The job's poses for the preview, through a KITTI trajectory export:
@@ -80,7 +75,7 @@ std::vector<Transform> TrajectoryOf(rpc::MapBuilderClient& client, const std::st
 }
 
 int RunExport(const ExportFlags& f) {
-  const auto [kind, output] = ResolveFormat(f);
+  const auto [format, output] = ResolveFormat(f);
   UpDetectionOptions up_options;
   up_options.sensor_up = ParseSensorUp(f.sensor_up);
   Daemon daemon = ConnectToDaemon(f.remote);
@@ -101,12 +96,12 @@ int RunExport(const ExportFlags& f) {
   if (!parent.empty()) fs::create_directories(parent);
   uint64_t bytes = 0;
   WriteFileAtomically(output, [&](const std::string& tmp) {
-    bytes = daemon.client->ExportToFile(f.job_id, kind.format, tmp, f.drive);
+    bytes = daemon.client->ExportToFile(f.job_id, format, tmp, f.drive);
   });
   std::fprintf(stderr, "wrote %s (%llu bytes)\n", output.c_str(),
                static_cast<unsigned long long>(bytes));
   const bool octomap =
-      kind.format == v1::EXPORT_FORMAT_OCTOMAP_BT || kind.format == v1::EXPORT_FORMAT_OCTOMAP_OT;
+      format == v1::EXPORT_FORMAT_OCTOMAP_BT || format == v1::EXPORT_FORMAT_OCTOMAP_OT;
   if (octomap && f.preview) {
     const std::string png = fs::path(output).replace_extension(".png").string();
     const UpDirection up = WriteMapPreview(

@@ -2,42 +2,15 @@
 
 #include <filesystem>
 
+#include "boicp/rpc/proto_convert.hpp"
 #include "storage_errors.hpp"
 
 namespace boicp::server {
 
-namespace {
-
-std::string DriveStem(uint32_t drive) { return "trajectory-drive" + std::to_string(drive); }
-
-}  // namespace
-
-std::optional<std::string> ExportFileName(int format, uint32_t drive) {
-  if (drive > 0) {
-    if (format == ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_TUM) return DriveStem(drive) + ".tum";
-    if (format == ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_KITTI) return DriveStem(drive) + ".kitti";
-    return std::nullopt;
-  }
-  switch (format) {
-    case ::boicp::v1::EXPORT_FORMAT_OCTOMAP_BT:
-      return "map.bt";
-    case ::boicp::v1::EXPORT_FORMAT_OCTOMAP_OT:
-      return "map.ot";
-    case ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_TUM:
-      return "trajectory.tum";
-    case ::boicp::v1::EXPORT_FORMAT_TRAJECTORY_KITTI:
-      return "trajectory.kitti";
-    case ::boicp::v1::EXPORT_FORMAT_POINT_CLOUD_PLY:
-      return "map.ply";
-    default:
-      return std::nullopt;
-  }
-}
-
 std::vector<std::string> DriveTrajectoryStems(const std::string& job_dir, size_t drives) {
   std::vector<std::string> stems;
   for (size_t d = 1; d <= drives; ++d) {
-    stems.push_back(job_dir + "/" + DriveStem(static_cast<uint32_t>(d)));
+    stems.push_back(job_dir + "/" + rpc::DriveTrajectoryStem(static_cast<uint32_t>(d)));
   }
   return stems;
 }

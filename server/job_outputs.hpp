@@ -1,21 +1,12 @@
 #pragma once
 // Names of the files a finished job leaves in its directory, per export format.
 
-#include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "boicp/mapping/map_assembly.hpp"
-#include "boicp/v1/map_builder.pb.h"
 
 namespace boicp::server {
-
-/// "map.bt", "map.ot", "trajectory.tum", "trajectory.kitti" or "map.ply";
-/// nullopt for a format value that is not one of the five. With `drive` K
-/// >= 1, a trajectory format's file of drive K alone,
-/// "trajectory-driveK.tum" or ".kitti" (nullopt for the others).
-std::optional<std::string> ExportFileName(int format, uint32_t drive = 0);
 
 /// "JOB_DIR/trajectory-driveK" for K = 1 .. drives: the stems of each
 /// drive's trajectory files in a job of several.

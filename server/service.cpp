@@ -184,7 +184,7 @@ grpc::ServerWriteReactor<v1::ExportChunk>* MapBuilderService::Export(
       }
       // The one drive of a job is all of it.
       const uint32_t drive = drives > 1 ? request->drive() : 0;
-      const std::optional<std::string> file = ExportFileName(request->format(), drive);
+      const std::optional<std::string> file = rpc::ExportFileName(request->format(), drive);
       if (!file && drive > 0) {
         throw InputError("drive: only the trajectory formats (tum, kitti) are per drive");
       }

@@ -256,4 +256,30 @@ double NowSeconds() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+std::string DriveTrajectoryStem(uint32_t drive) {
+  return "trajectory-drive" + std::to_string(drive);
+}
+
+std::optional<std::string> ExportFileName(int format, uint32_t drive) {
+  if (drive > 0) {
+    if (format == v1::EXPORT_FORMAT_TRAJECTORY_TUM) return DriveTrajectoryStem(drive) + ".tum";
+    if (format == v1::EXPORT_FORMAT_TRAJECTORY_KITTI) return DriveTrajectoryStem(drive) + ".kitti";
+    return std::nullopt;
+  }
+  switch (format) {
+    case v1::EXPORT_FORMAT_OCTOMAP_BT:
+      return "map.bt";
+    case v1::EXPORT_FORMAT_OCTOMAP_OT:
+      return "map.ot";
+    case v1::EXPORT_FORMAT_TRAJECTORY_TUM:
+      return "trajectory.tum";
+    case v1::EXPORT_FORMAT_TRAJECTORY_KITTI:
+      return "trajectory.kitti";
+    case v1::EXPORT_FORMAT_POINT_CLOUD_PLY:
+      return "map.ply";
+    default:
+      return std::nullopt;
+  }
+}
+
 }  // namespace boicp::rpc

@@ -237,8 +237,14 @@ SyntheticScan SyntheticDrive::Scan(int index) const {
   scan.T_world_scan = Pose(index);
   const bool returning = index >= static_cast<int>(station_x_.size());
   const Eigen::Vector3d travel(returning ? -kSweepTravel : kSweepTravel, 0.0, 0.0);
+  // The true pose is the sweep's middle, where a rigid fit of the whole sweep
+  // lands; the sweep starts half its motion before it.
+  Transform T_world_start = scan.T_world_scan;
+  T_world_start.topLeftCorner<3, 3>() *=
+      Eigen::AngleAxisd(-0.5 * kSweepTurn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_world_start.topRightCorner<3, 1>() -= 0.5 * travel;
   const auto simulate = [&](const Points& world, uint64_t seed) {
-    return drift_ ? SimulateSweptScan(world, scan.T_world_scan, travel, kSweepTurn, kScanRange,
+    return drift_ ? SimulateSweptScan(world, T_world_start, travel, kSweepTurn, kScanRange,
                                       kScanNoise, seed)
                   : SimulateScan(world, scan.T_world_scan, kScanRange, kScanNoise, seed);
   };

@@ -66,7 +66,8 @@ class SyntheticDrive {
 
   int size() const { return num_scans_; }
 
-  /// True T_world_scan of scan `index` in [0, size()): where its sweep starts.
+  /// True T_world_scan of scan `index` in [0, size()); with `drift`, where
+  /// the sensor is halfway through the scan's sweep.
   Transform Pose(int index) const;
 
   /// Scan `index` in [0, size()): the same points for the same seed, and for

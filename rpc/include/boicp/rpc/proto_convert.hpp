@@ -3,6 +3,8 @@
 // and its clients alike, with the validation of what the other side sent
 // (every failure is an InputError naming the field).
 
+#include <cstdint>
+#include <optional>
 #include <string>
 
 #include "boicp/io/point_cloud_io.hpp"
@@ -29,6 +31,16 @@ v1::Vector3 PointToProto(const Point& point);
 CloudFormat FormatFromProto(int format);
 /// SCAN_FORMAT_UNSPECIFIED for kAuto.
 v1::ScanFormat ScanFormatOf(CloudFormat format);
+
+/// "trajectory-driveK", the stem of drive K's trajectory files (K >= 1).
+std::string DriveTrajectoryStem(uint32_t drive);
+
+/// The file a job's export is stored and saved as: "map.bt", "map.ot",
+/// "trajectory.tum", "trajectory.kitti" or "map.ply"; nullopt for a format
+/// value that is not one of the five. With `drive` K >= 1, a trajectory
+/// format's file of drive K alone, "trajectory-driveK.tum" or ".kitti"
+/// (nullopt for the others).
+std::optional<std::string> ExportFileName(int format, uint32_t drive = 0);
 
 /// Format and depth options to load a stored scan with. Throws InputError
 /// when a depth image lacks intrinsics or scale.
