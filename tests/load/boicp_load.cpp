@@ -1,7 +1,7 @@
 // boicp_load: the daemon under 20 concurrent clients. Starts boicpd on a
 // free loopback port, runs the load, prints the figures (and writes them to
-// --out), and exits 1 when a check fails. The ctest runs it briefly; README
-// "Reliability" has a longer run.
+// --out), and exits 1 when a check fails. The ctest runs it briefly;
+// docs/reliability.md, "Load", has a longer run.
 
 #include <unistd.h>
 
