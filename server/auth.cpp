@@ -1,5 +1,10 @@
 #include "auth.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -27,7 +32,37 @@ bool SameSecret(const std::string& a, const std::string& b) {
   return diff == 0;
 }
 
+// RFC 6750 takes the scheme name case-insensitively ("bearer" is "Bearer").
+bool StartsWithScheme(const std::string& value, const std::string& scheme) {
+  if (value.size() <= scheme.size() || value[scheme.size()] != ' ') return false;
+  for (size_t i = 0; i < scheme.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(value[i])) !=
+        std::tolower(static_cast<unsigned char>(scheme[i]))) {
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+std::vector<std::string> BearerAuth::TokenFileWarnings(const std::string& path) {
+  struct stat status {};
+  if (stat(path.c_str(), &status) != 0) return {};
+  std::vector<std::string> warnings;
+  if ((status.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(status.st_mode & 07777));
+    warnings.push_back("auth token file " + path + " is open to group or others (mode " + mode +
+                       "): chmod 600 " + path);
+  }
+  if (status.st_uid != geteuid()) {
+    warnings.push_back("auth token file " + path + " is owned by uid " +
+                       std::to_string(status.st_uid) + ", not by this daemon's user (uid " +
+                       std::to_string(geteuid()) + "): another user can change the token");
+  }
+  return warnings;
+}
 
 BearerAuth BearerAuth::FromFile(const std::string& path) {
   BearerAuth auth;
@@ -45,9 +80,8 @@ grpc::Status BearerAuth::Check(const grpc::ServerContextBase& context) const {
                         "missing 'authorization: Bearer <token>' metadata");
   }
   const std::string value(found->second.data(), found->second.size());
-  const std::string prefix = "Bearer ";
-  if (value.compare(0, prefix.size(), prefix) != 0 ||
-      !SameSecret(value.substr(prefix.size()), *token_)) {
+  const std::string scheme = "Bearer";
+  if (!StartsWithScheme(value, scheme) || !SameSecret(value.substr(scheme.size() + 1), *token_)) {
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "invalid bearer token");
   }
   return grpc::Status::OK;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_context.h>
@@ -20,9 +21,15 @@ class BearerAuth {
   /// std::runtime_error when the file is unreadable or empty.
   static BearerAuth FromFile(const std::string& path);
 
+  /// What is unsafe about the token file at `path`, one line each, naming
+  /// the fix: group or others may read it, or another user owns it. Empty
+  /// when it is safe or cannot be examined (FromFile then says why).
+  static std::vector<std::string> TokenFileWarnings(const std::string& path);
+
   bool enabled() const { return token_.has_value(); }
 
-  /// OK, or UNAUTHENTICATED with a message saying what was missing.
+  /// OK, or UNAUTHENTICATED with a message saying what was missing. The
+  /// scheme name ("Bearer") is matched case-insensitively (RFC 6750).
   grpc::Status Check(const grpc::ServerContextBase& context) const;
 
  private:

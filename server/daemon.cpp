@@ -29,7 +29,12 @@ void ApplyTransportLimits(const DaemonOptions& o, grpc::ServerBuilder& builder) 
 }  // namespace
 
 Daemon::Daemon(const DaemonOptions& options) : options_(options) {
-  if (!options_.auth_token_file.empty()) auth_ = BearerAuth::FromFile(options_.auth_token_file);
+  if (!options_.auth_token_file.empty()) {
+    auth_ = BearerAuth::FromFile(options_.auth_token_file);
+    for (const std::string& warning : BearerAuth::TokenFileWarnings(options_.auth_token_file)) {
+      spdlog::warn("{}", warning);
+    }
+  }
   auto credentials =
       MakeServerCredentials(options_.tls_cert, options_.tls_key, options_.tls_client_ca);
 

@@ -3,6 +3,7 @@
 // (RESOURCE_EXHAUSTED) are in test_limits.cpp.
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 
 #include <gmock/gmock.h>
@@ -14,6 +15,7 @@ namespace boicp::test {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 class BadInput : public ServerTest {};
 
@@ -151,6 +153,38 @@ TEST_F(BadInput, BearerTokenIsRequiredWhenConfigured) {
             Code::UNAUTHENTICATED);
   EXPECT_EQ(CodeOf([&] { right.GetJob("job-000001"); }), Code::NOT_FOUND);
   EXPECT_EQ(right.Upload("1 2 3\n4 5 6\n", Meta(v1::SCAN_FORMAT_XYZ, 0)).num_points(), 2u);
+
+  // The scheme name is case-insensitive (RFC 6750); the token is not.
+  const auto find_with = [&](const std::string& authorization) {
+    grpc::ClientContext context;
+    context.AddMetadata("authorization", authorization);
+    v1::FindScansRequest find;
+    find.add_scan_ids(std::string(64, 'a'));
+    v1::FindScansResponse found;
+    return anonymous.stub().FindScans(&context, find, &found).error_code();
+  };
+  EXPECT_EQ(find_with("bearer s3cret-token"), Code::OK);
+  EXPECT_EQ(find_with("BEARER s3cret-token"), Code::OK);
+  EXPECT_EQ(find_with("Bearer S3CRET-TOKEN"), Code::UNAUTHENTICATED);
+  EXPECT_EQ(find_with("Bearers3cret-token"), Code::UNAUTHENTICATED);
+}
+
+// A token file others can read is named in the log with its fix; one only
+// its owner reads is not.
+TEST_F(BadInput, ATokenFileOthersCanReadIsWarnedAbout) {
+  const std::filesystem::path token_file = dir_ / "token";
+  std::ofstream(token_file) << "s3cret-token\n";
+  std::filesystem::permissions(
+      token_file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                      std::filesystem::perms::group_read | std::filesystem::perms::others_read);
+  StartDaemon({"--workers", "1", "--auth-token-file", token_file.string()});
+  EXPECT_THAT(daemon_->Log(), HasSubstr("is open to group or others (mode 0644): chmod 600 " +
+                                        token_file.string()));
+
+  std::filesystem::permissions(
+      token_file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  StartDaemon({"--workers", "1", "--auth-token-file", token_file.string()});
+  EXPECT_THAT(daemon_->Log(), Not(HasSubstr("auth token file")));
 }
 
 // An empty BOICPD_AUTH_TOKEN_FILE reads as "no flag" to the option parser;
