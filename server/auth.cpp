@@ -3,7 +3,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cctype>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -30,18 +29,6 @@ bool SameSecret(const std::string& a, const std::string& b) {
     diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
   }
   return diff == 0;
-}
-
-// RFC 6750 takes the scheme name case-insensitively ("bearer" is "Bearer").
-bool StartsWithScheme(const std::string& value, const std::string& scheme) {
-  if (value.size() <= scheme.size() || value[scheme.size()] != ' ') return false;
-  for (size_t i = 0; i < scheme.size(); ++i) {
-    if (std::tolower(static_cast<unsigned char>(value[i])) !=
-        std::tolower(static_cast<unsigned char>(scheme[i]))) {
-      return false;
-    }
-  }
-  return true;
 }
 
 }  // namespace
@@ -80,8 +67,10 @@ grpc::Status BearerAuth::Check(const grpc::ServerContextBase& context) const {
                         "missing 'authorization: Bearer <token>' metadata");
   }
   const std::string value(found->second.data(), found->second.size());
-  const std::string scheme = "Bearer";
-  if (!StartsWithScheme(value, scheme) || !SameSecret(value.substr(scheme.size() + 1), *token_)) {
+  // RFC 6750 takes the scheme name in any case ("bearer" is "Bearer").
+  const std::string scheme = "bearer ";
+  if (LowerCase(value.substr(0, scheme.size())) != scheme ||
+      !SameSecret(value.substr(scheme.size()), *token_)) {
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "invalid bearer token");
   }
   return grpc::Status::OK;

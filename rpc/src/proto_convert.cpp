@@ -12,6 +12,7 @@
 
 #include "boicp/registration/bo_icp.hpp"
 #include "boicp/rpc/sha256.hpp"
+#include "boicp/util/text.hpp"
 
 namespace boicp::rpc {
 namespace {
@@ -219,10 +220,7 @@ constexpr const char kStagePrefix[] = "JOB_STAGE_";
 
 void SetJobStage(v1::Job& job, v1::JobStage stage) {
   job.set_stage_code(stage);
-  std::string name = v1::JobStage_Name(stage).substr(sizeof(kStagePrefix) - 1);
-  std::transform(name.begin(), name.end(), name.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  job.set_stage(name);
+  job.set_stage(LowerCase(v1::JobStage_Name(stage).substr(sizeof(kStagePrefix) - 1)));
 }
 
 v1::JobStage JobStageOf(MapStage stage) { return JobStageFromName(MapStageName(stage)); }

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "bag_readers.hpp"
+#include "boicp/util/text.hpp"
 #include "boicp/util/types.hpp"
 
 namespace boicp {
@@ -13,12 +14,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string LowerExtension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
+std::string LowerExtension(const fs::path& path) { return LowerCase(path.extension().string()); }
 
 // The storage plugin a ROS 2 bag folder names ("sqlite3", "mcap"), or empty.
 std::string StorageIdentifier(const fs::path& metadata) {

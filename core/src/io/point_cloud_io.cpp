@@ -4,9 +4,9 @@
 #include "boicp/io/point_cloud_io.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 
+#include "boicp/util/text.hpp"
 #include "io/io_readers.hpp"
 
 namespace boicp {
@@ -14,12 +14,6 @@ namespace boicp {
 namespace {
 
 constexpr const char* kSupportedExtensions = ".bin .pcd .ply .xyz .txt .png";
-
-std::string ToLower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
 
 Points ReadPoints(const std::string& path, CloudFormat format, const LoadOptions& options) {
   const uint64_t limit = options.max_points;
@@ -67,7 +61,7 @@ void RequirePointCount(const std::string& path, uint64_t points, uint64_t max_po
 }  // namespace io_detail
 
 CloudFormat ParseCloudFormat(const std::string& name) {
-  const std::string key = ToLower(name);
+  const std::string key = LowerCase(name);
   if (key == "auto") return CloudFormat::kAuto;
   if (key == "kitti" || key == "bin") return CloudFormat::kKittiBin;
   if (key == "pcd") return CloudFormat::kPcd;
@@ -99,7 +93,7 @@ std::string CloudFormatName(CloudFormat format) {
 }
 
 CloudFormat DetectCloudFormat(const std::string& path) {
-  const std::string extension = ToLower(std::filesystem::path(path).extension().string());
+  const std::string extension = LowerCase(std::filesystem::path(path).extension().string());
   if (extension == ".bin") return CloudFormat::kKittiBin;
   if (extension == ".pcd") return CloudFormat::kPcd;
   if (extension == ".ply") return CloudFormat::kPly;

@@ -11,6 +11,7 @@
 
 #include "boicp/io/trajectory_io.hpp"
 #include "boicp/util/parallel_for.hpp"
+#include "boicp/util/text.hpp"
 #include "io/io_readers.hpp"
 
 namespace boicp {
@@ -21,12 +22,6 @@ using io_detail::FullListing;
 using io_detail::IsBlankOrComment;
 using io_detail::ParseNumber;
 using io_detail::SplitFields;
-
-std::string Lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
 
 bool IsDirectory(const fs::path& path) {
   std::error_code ec;
@@ -51,7 +46,7 @@ std::vector<fs::path> ListFiles(const fs::path& dir,
   std::error_code ec;
   for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
     if (!IsFile(entry.path())) continue;
-    if (keep(Lower(entry.path().filename().string()))) files.push_back(entry.path());
+    if (keep(LowerCase(entry.path().filename().string()))) files.push_back(entry.path());
   }
   if (ec) throw InputError(dir.string() + ": cannot list (" + ec.message() + ")");
   std::sort(files.begin(), files.end(),
@@ -197,7 +192,7 @@ FullListing ListKitti(const fs::path& root) {
 }
 
 std::optional<Intrinsics> TumCameraIntrinsics(std::string name) {
-  name = Lower(name);
+  name = LowerCase(name);
   if (name.find("freiburg1") != std::string::npos || name.find("fr1") != std::string::npos) {
     return Intrinsics{517.3, 516.5, 318.6, 255.3};
   }
@@ -213,7 +208,7 @@ std::optional<Intrinsics> TumCameraIntrinsics(std::string name) {
 Intrinsics ResolveTumIntrinsics(const fs::path& root, const ScanFolderOptions& options) {
   if (options.intrinsics) return *options.intrinsics;
   if (!options.tum_camera.empty()) {
-    const std::string camera = Lower(options.tum_camera);
+    const std::string camera = LowerCase(options.tum_camera);
     if (camera != "fr1" && camera != "fr2" && camera != "fr3") {
       throw InputError("camera: '" + options.tum_camera + "' is not fr1, fr2 or fr3");
     }
@@ -331,7 +326,7 @@ FullListing ListCloudFiles(const fs::path& root) {
   const std::vector<fs::path> files = ListFiles(root, IsCloudFileName);
   if (files.empty()) throw InputError(root.string() + ": no .pcd, .ply or .xyz files");
   std::set<std::string> extensions;
-  for (const fs::path& file : files) extensions.insert(Lower(file.extension().string()));
+  for (const fs::path& file : files) extensions.insert(LowerCase(file.extension().string()));
   if (extensions.size() > 1) {
     std::string list;
     for (const std::string& ext : extensions) list += (list.empty() ? "" : ", ") + ext;
@@ -404,7 +399,7 @@ ScanFolder Select(FullListing all, const ScanFolderOptions& options, const std::
 }  // namespace
 
 ScanLayout ParseScanLayout(const std::string& name) {
-  const std::string n = Lower(name);
+  const std::string n = LowerCase(name);
   if (n == "auto") return ScanLayout::kAuto;
   if (n == "kitti") return ScanLayout::kKitti;
   if (n == "tum") return ScanLayout::kTum;
@@ -490,7 +485,7 @@ ScanFolder ReadScanList(const std::vector<std::string>& paths, const ScanFolderO
       scan.load.depth.intrinsics = options.intrinsics;
       scan.load.depth.depth_scale = options.depth_scale;
     }
-    extensions.insert(Lower(fs::path(path).extension().string()));
+    extensions.insert(LowerCase(fs::path(path).extension().string()));
     all.scans.push_back(std::move(scan));
   }
   for (const std::string& ext : extensions) all.what += (all.what.empty() ? "*" : ", *") + ext;

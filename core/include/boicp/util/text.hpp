@@ -9,4 +9,8 @@ namespace boicp {
 /// line feeds (a line read from a token file or /proc).
 std::string Trim(const std::string& text);
 
+/// `text` with its letters lowered one byte at a time (std::tolower), for
+/// extensions, names and keywords that are matched in any case.
+std::string LowerCase(std::string text);
+
 }  // namespace boicp
